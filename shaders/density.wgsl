@@ -1,0 +1,39 @@
+// Summation density rho_i = m_i sum_j W_ij (F22 §3.3) and EOS p = c²(rho - rho0)
+// (F22 (3)), clamped at 0 with the pressure floor. Twin of src/backend/cpu/density.rs.
+
+fn equation_of_state(ph: u32, r: f32) -> f32 {
+    let m = P.phase_a[ph];
+    let p = m.y * (r - m.x);
+    if ((P.grid.w & FLAG_PRESSURE_FLOOR) != 0u) {
+        return max(p, 0.0);
+    }
+    return p;
+}
+
+@compute @workgroup_size(64)
+fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (is_wall(ph)) { return; }
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var sum = 0.0;
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let r2 = len2(min_image(pi, pos[j]));
+                    if (r2 < P.kern.w) {
+                        sum = sum + kernel_w(sqrt(r2));
+                    }
+                }
+            }
+        }
+    }
+    let r = mass[i] * sum;
+    rho[i] = r;
+    press[i] = equation_of_state(ph, r);
+}

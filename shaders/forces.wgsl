@@ -1,0 +1,72 @@
+// Pressure + viscous forces F22 (23), transport-velocity background pressure
+// (Adami 2013) and gravity. Twin of src/backend/cpu/forces.rs, which explains the
+// wall treatment.
+
+@compute @workgroup_size(64)
+fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph_i = phase[i];
+    if (is_wall(ph_i)) { return; }
+    let mat_i = P.phase_a[ph_i];
+    let rho_i = rho[i];
+    let p_i = press[i];
+    let m_i = mass[i];
+    let eta_i = mat_i.z;
+    let v_i = vel[i];
+    let vol_i = m_i / rho_i;
+    let pb = P.gravity.w;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var f = vec3<f32>(0.0);
+    var fb = vec3<f32>(0.0);
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let d = min_image(pi, pos[j]);
+                    let r2 = len2(d);
+                    if (r2 < P.kern.w && r2 > 0.0) {
+                        let r = sqrt(r2);
+                        let dwdr = kernel_dw(r);
+                        let ph_j = phase[j];
+                        let mat_j = P.phase_a[ph_j];
+                        let wall = mat_j.w == KIND_WALL;
+                        let p_j = press[j];
+                        var rho_j = rho[j];
+                        var m_j = mass[j];
+                        var eta_j = mat_j.z;
+                        if (wall) {
+                            rho_j = mat_i.x + p_j / mat_i.y;
+                            m_j = m_i;
+                            eta_j = eta_i;
+                        }
+                        let slip = wall && P.phase_b[ph_j].w != 0.0;
+                        let vol_j = m_j / rho_j;
+                        let vv = vol_i * vol_i + vol_j * vol_j;
+                        let p_avg = (rho_j * p_i + rho_i * p_j) / (rho_i + rho_j);
+                        let eta_sum = eta_i + eta_j;
+                        var eta_avg = 0.0;
+                        if (eta_sum > 0.0 && !slip) {
+                            eta_avg = c_two() * eta_i * eta_j / eta_sum;
+                        }
+                        let fp = -p_avg * dwdr / r;
+                        let fv = eta_avg * dwdr / r;
+                        let fbg = -pb * dwdr / r;
+                        let v_j = vel[j];
+                        for (var a = 0u; a < 3u; a++) {
+                            let u = v_i[a] - v_j[a];
+                            f[a] = f[a] + vv * (fp * d[a] + fv * u);
+                            fb[a] = fb[a] + vv * (fbg * d[a]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let g = P.gravity;
+    acc[i] = vec4<f32>(f.x / m_i + g.x, f.y / m_i + g.y, f.z / m_i + g.z, 0.0);
+    acc_b[i] = vec4<f32>(fb.x / m_i, fb.y / m_i, fb.z / m_i, 0.0);
+}

@@ -1,0 +1,73 @@
+// Max |u|² and |a|² over fluid particles by a fixed two-level tree (per-workgroup,
+// then one workgroup over the partials), then the F22 (42) time step.
+// Twin of src/backend/cpu/timestep.rs.
+
+const RWG: u32 = 256u;
+var<workgroup> red: array<vec2<f32>, 256>;
+
+fn tree_max(t: u32) {
+    for (var s = RWG / 2u; s > 0u; s = s / 2u) {
+        workgroupBarrier();
+        if (t < s) {
+            red[t] = max(red[t], red[t + s]);
+        }
+    }
+    workgroupBarrier();
+}
+
+@compute @workgroup_size(256)
+fn reduce(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = wid.x + wid.y * nwg.x;
+    let i = g * RWG + t;
+    var m = vec2<f32>(0.0, 0.0);
+    if (i < P.counts.x && !is_wall(phase[i])) {
+        let v = vel[i];
+        let a = acc[i];
+        m = vec2<f32>(v.x * v.x + v.y * v.y + v.z * v.z, a.x * a.x + a.y * a.y + a.z * a.z);
+    }
+    red[t] = m;
+    tree_max(t);
+    if (t == 0u) {
+        partials[g] = red[0];
+    }
+}
+
+@compute @workgroup_size(256)
+fn finalize(@builtin(local_invocation_index) t: u32) {
+    let groups = (P.counts.x + RWG - 1u) / RWG;
+    var m = vec2<f32>(0.0, 0.0);
+    for (var g = t; g < groups; g += RWG) {
+        m = max(m, partials[g]);
+    }
+    red[t] = m;
+    tree_max(t);
+    if (t != 0u) { return; }
+    let umax2 = red[0].x;
+    let amax2 = red[0].y;
+    if (sim.dt > 0.0) {
+        sim.step = sim.step + 1u;
+    }
+    sim.time = sim.time + sim.dt;
+    sim.umax2 = umax2;
+    sim.amax2 = amax2;
+    let h = P.dtp.x;
+    var dt = c_quarter() * h / (P.dtp.y + sqrt(umax2));
+    var which = 0u;
+    if (P.dtp.z < dt) {
+        dt = P.dtp.z;
+        which = 1u;
+    }
+    if (amax2 > 0.0) {
+        let f = c_quarter() * sqrt(h / sqrt(amax2));
+        if (f < dt) {
+            dt = f;
+            which = 2u;
+        }
+    }
+    if (P.dtp.w > 0.0) {
+        dt = P.dtp.w;
+        which = 3u;
+    }
+    sim.dt = dt;
+    sim.dt_limit = which;
+}

@@ -1,0 +1,54 @@
+// Generalized wall boundary (Adami, Hu & Adams 2012): each wall particle gathers
+// pressure and velocity from its fluid neighbours. Twin of src/backend/cpu/wall.rs.
+
+@compute @workgroup_size(64)
+fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (!is_wall(ph)) { return; }
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var sw = 0.0;
+    var sp = 0.0;
+    var sr = vec3<f32>(0.0);
+    var sv = vec3<f32>(0.0);
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let d = min_image(pi, pos[j]);
+                    let r2 = len2(d);
+                    if (r2 < P.kern.w && !is_wall(phase[j])) {
+                        let wk = kernel_w(sqrt(r2));
+                        sw = sw + wk;
+                        sp = sp + press[j] * wk;
+                        let rw = rho[j] * wk;
+                        let v = vel[j];
+                        for (var a = 0u; a < 3u; a++) {
+                            sr[a] = sr[a] + rw * d[a];
+                            sv[a] = sv[a] + v[a] * wk;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let b = P.phase_b[ph];
+    let m = P.phase_a[ph];
+    var p = 0.0;
+    var v = vec4<f32>(b.x, b.y, b.z, 0.0);
+    if (sw > 0.0) {
+        let g = P.gravity;
+        p = (sp + (g.x * sr.x + g.y * sr.y + g.z * sr.z)) / sw;
+        v = vec4<f32>(c_two() * b.x - sv.x / sw, c_two() * b.y - sv.y / sw, c_two() * b.z - sv.z / sw, 0.0);
+    }
+    if ((P.grid.w & FLAG_PRESSURE_FLOOR) != 0u) {
+        p = max(p, 0.0);
+    }
+    rho[i] = m.x + p / m.y;
+    press[i] = p;
+    vel[i] = v;
+}

@@ -1,0 +1,88 @@
+//! CPU reference backend: the twin of every WGSL pass, rayon-parallel over particles.
+//! Each particle gathers from its own neighbours, so the result does not depend on
+//! the thread count or schedule.
+
+mod density;
+mod forces;
+mod integrate;
+mod neighbors;
+mod timestep;
+mod wall;
+
+use super::{Backend, Stage};
+use crate::params::Params;
+use crate::state::{Sim, State};
+use std::time::Instant;
+
+pub struct CpuBackend {
+    pub params: Params,
+    pub st: State,
+    grid: neighbors::CellTable,
+    times: Vec<(&'static str, f64)>,
+}
+
+impl CpuBackend {
+    pub fn new(params: Params, st: State) -> Self {
+        CpuBackend {
+            params,
+            st,
+            grid: neighbors::CellTable::default(),
+            times: Vec::new(),
+        }
+    }
+}
+
+impl CpuBackend {
+    /// Interacting pairs (i fluid, j any, r_ij < support) in the current cell table,
+    /// the unit of DualSPHysics' PIPS.
+    pub fn pair_count(&self) -> u64 {
+        use rayon::prelude::*;
+        let (pr, st, grid) = (&self.params, &self.st, &self.grid);
+        (0..st.len())
+            .into_par_iter()
+            .filter(|&i| !pr.is_wall(st.phase[i]))
+            .map(|i| {
+                let mut n = 0u64;
+                neighbors::for_each_neighbor(pr, &st.pos, grid, i, |j, _, _| n += (j != i) as u64);
+                n
+            })
+            .sum()
+    }
+}
+
+impl Backend for CpuBackend {
+    fn describe(&self) -> String {
+        format!("cpu ({} threads)", rayon::current_num_threads())
+    }
+    fn is_software(&self) -> bool {
+        true
+    }
+    fn run_stage(&mut self, stage: Stage) {
+        let t0 = Instant::now();
+        let pr = &self.params;
+        match stage {
+            Stage::KickDrift => integrate::kick_drift(pr, &mut self.st),
+            Stage::Neighbors => neighbors::run(pr, &mut self.st, &mut self.grid),
+            Stage::Density => density::run(pr, &mut self.st, &self.grid),
+            Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
+            Stage::Forces => forces::run(pr, &mut self.st, &self.grid),
+            Stage::Kick => integrate::kick(pr, &mut self.st),
+            Stage::Timestep => timestep::run(pr, &mut self.st),
+        }
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let name = stage.name();
+        match self.times.iter_mut().find(|(n, _)| *n == name) {
+            Some(e) => e.1 += ms,
+            None => self.times.push((name, ms)),
+        }
+    }
+    fn read_state(&mut self) -> State {
+        self.st.clone()
+    }
+    fn read_sim(&mut self) -> Sim {
+        self.st.sim
+    }
+    fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
+        std::mem::take(&mut self.times)
+    }
+}

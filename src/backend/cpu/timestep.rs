@@ -1,0 +1,55 @@
+//! Twin of shaders/timestep.wgsl: advance time by the Δt just used, then the next
+//! Δt from F22 (42): min{0.25 h/(c+|u|max), 0.125 h²/ν, 0.25 √(h/|a|max)}.
+//! Max over floats is exact and order-free, so this plain fold gives the same bits
+//! as the GPU's two-level tree.
+
+use crate::params::Params;
+use crate::state::State;
+use rayon::prelude::*;
+
+pub fn run(pr: &Params, st: &mut State) {
+    let (umax2, amax2) = (0..st.len())
+        .into_par_iter()
+        .filter(|&i| !pr.is_wall(st.phase[i]))
+        .map(|i| {
+            let (v, a) = (st.vel[i], st.acc[i]);
+            (
+                v[0] * v[0] + v[1] * v[1] + v[2] * v[2],
+                a[0] * a[0] + a[1] * a[1] + a[2] * a[2],
+            )
+        })
+        .reduce(|| (0.0f32, 0.0f32), |x, y| (x.0.max(y.0), x.1.max(y.1)));
+    let sim = &mut st.sim;
+    if sim.dt > 0.0 {
+        sim.step += 1;
+    }
+    sim.time += sim.dt;
+    sim.umax2 = umax2;
+    sim.amax2 = amax2;
+    let (dt, which) = next_dt(pr, umax2, amax2);
+    sim.dt = dt;
+    sim.dt_limit = which;
+}
+
+/// The F22 (42) limit that binds: 0 acoustic, 1 viscous, 2 force, 3 fixed.
+pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
+    let h = pr.dt[0];
+    let mut dt = 0.25 * h / (pr.dt[1] + umax2.sqrt());
+    let mut which = 0u32;
+    if pr.dt[2] < dt {
+        dt = pr.dt[2];
+        which = 1;
+    }
+    if amax2 > 0.0 {
+        let f = 0.25 * (h / amax2.sqrt()).sqrt();
+        if f < dt {
+            dt = f;
+            which = 2;
+        }
+    }
+    if pr.dt[3] > 0.0 {
+        dt = pr.dt[3];
+        which = 3;
+    }
+    (dt, which)
+}

@@ -1,0 +1,70 @@
+//! Twin of shaders/wall.wgsl: generalized wall boundary (Adami, Hu & Adams 2012).
+//! Each wall particle w gathers from its fluid neighbours f:
+//!   p_w = (Σ p_f W_wf + g·Σ ρ_f r_wf W_wf) / Σ W_wf        (stationary wall, a_w = 0)
+//!   ũ_w = Σ u_f W_wf / Σ W_wf,  u_w = 2 u_wall − ũ_w        (no-slip velocity)
+//! The wall's displayed density is its material's EOS inverted at p_w.
+
+use super::neighbors::{for_each_neighbor, CellTable};
+use crate::kernel;
+use crate::params::{Params, FLAG_PRESSURE_FLOOR};
+use crate::state::State;
+use rayon::prelude::*;
+
+pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
+    let n = st.len();
+    let (pos, phase) = (&st.pos, &st.phase);
+    let (rho_in, p_in, vel_in) = (&st.rho, &st.p, &st.vel);
+    let out: Vec<Option<(f32, f32, [f32; 4])>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let ph = phase[i];
+            if !pr.is_wall(ph) {
+                return None;
+            }
+            let mut sw = 0.0f32;
+            let mut sp = 0.0f32;
+            let mut sr = [0.0f32; 3];
+            let mut sv = [0.0f32; 3];
+            for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
+                if pr.is_wall(phase[j]) {
+                    return;
+                }
+                let wk = kernel::w(pr, r2.sqrt());
+                sw += wk;
+                sp += p_in[j] * wk;
+                let rw = rho_in[j] * wk;
+                let v = vel_in[j];
+                for a in 0..3 {
+                    sr[a] += rw * d[a];
+                    sv[a] += v[a] * wk;
+                }
+            });
+            let b = pr.phase_b[ph as usize];
+            let m = pr.phase_a[ph as usize];
+            let (mut p, v) = if sw > 0.0 {
+                let g = pr.gravity;
+                let p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / sw;
+                let v = [
+                    2.0 * b[0] - sv[0] / sw,
+                    2.0 * b[1] - sv[1] / sw,
+                    2.0 * b[2] - sv[2] / sw,
+                    0.0,
+                ];
+                (p, v)
+            } else {
+                (0.0, [b[0], b[1], b[2], 0.0])
+            };
+            if pr.grid[3] & FLAG_PRESSURE_FLOOR != 0 {
+                p = p.max(0.0);
+            }
+            Some((m[0] + p / m[1], p, v))
+        })
+        .collect();
+    for (i, o) in out.into_iter().enumerate() {
+        if let Some((rho, p, v)) = o {
+            st.rho[i] = rho;
+            st.p[i] = p;
+            st.vel[i] = v;
+        }
+    }
+}

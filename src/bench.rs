@@ -1,0 +1,169 @@
+//! `spatter bench throughput`: the 3D dam break at several sizes on each backend.
+//! Reports particle-steps/s (GPUSPH's MIPPS unit ×1e6), pair interactions/s
+//! (DualSPHysics' PIPS) and per-pass milliseconds.
+
+use crate::backend::cpu::CpuBackend;
+use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
+use crate::backend::Backend;
+use crate::error::SpatterError;
+use crate::params::Params;
+use crate::run::{BackendChoice, Loaded};
+use crate::{model, scene, setup};
+use std::time::Instant;
+
+const SCENE: &str = include_str!("../scenarios/validation/dam_break_3d.toml");
+const SCENE_NAME: &str = "scenarios/validation/dam_break_3d.toml";
+/// Software adapters run ~1000× slower than a GPU; larger sizes would take hours.
+const SOFTWARE_MAX_PARTICLES: usize = 150_000;
+
+#[derive(serde::Serialize)]
+pub struct BenchRow {
+    pub backend: String,
+    pub particles: usize,
+    pub dx: f64,
+    pub steps: u32,
+    pub wall_s: f64,
+    pub particle_steps_per_s: f64,
+    pub pair_interactions_per_s: f64,
+    pub neighbours_per_fluid_particle: f64,
+    pub pass_ms: Vec<(String, f64)>,
+}
+
+fn load_at(dx: f64) -> Result<Loaded, SpatterError> {
+    let sets = [format!("dx={dx}")];
+    let (sc, resolved) = scene::parse_str(SCENE_NAME, SCENE, &sets)?;
+    let model = model::build(SCENE_NAME, &sc, &resolved)?;
+    let state = setup::generate(&model, &sc)?;
+    Ok(Loaded { model, state })
+}
+
+/// Scene with about `target` particles: Δx scaled by the cube root of the count ratio.
+fn scene_of_size(target: f64) -> Result<Loaded, SpatterError> {
+    let (sc, resolved) = scene::parse_str(SCENE_NAME, SCENE, &[])?;
+    let mut dx = model::build(SCENE_NAME, &sc, &resolved)?.dx;
+    let mut l = load_at(dx)?;
+    for _ in 0..4 {
+        let ratio = l.state.len() as f64 / target;
+        if (ratio - 1.0).abs() < 0.1 {
+            break;
+        }
+        dx *= ratio.cbrt();
+        l = load_at(dx)?;
+    }
+    Ok(l)
+}
+
+fn measure(l: &Loaded, backend: &mut dyn Backend, steps: u32, pairs: u64) -> BenchRow {
+    backend.prime();
+    backend.run_steps(2);
+    backend.read_sim();
+    backend.take_pass_times();
+    let t0 = Instant::now();
+    backend.run_steps(steps);
+    backend.read_sim();
+    let wall_s = t0.elapsed().as_secs_f64();
+    let n = l.state.len();
+    let fluid = l
+        .state
+        .phase
+        .iter()
+        .filter(|&&p| l.model.phases[p as usize].is_fluid())
+        .count()
+        .max(1);
+    BenchRow {
+        backend: backend.describe(),
+        particles: n,
+        dx: l.model.dx,
+        steps,
+        wall_s,
+        particle_steps_per_s: n as f64 * steps as f64 / wall_s,
+        pair_interactions_per_s: pairs as f64 * steps as f64 / wall_s,
+        neighbours_per_fluid_particle: pairs as f64 / fluid as f64,
+        pass_ms: Vec::new(),
+    }
+}
+
+fn per_step(times: Vec<(&'static str, f64)>, steps: u32) -> Vec<(String, f64)> {
+    times
+        .into_iter()
+        .map(|(n, ms)| (n.to_string(), ms / steps as f64))
+        .collect()
+}
+
+pub fn throughput(
+    sizes: &[f64],
+    steps: u32,
+    backends: &[BackendChoice],
+    json: Option<&str>,
+) -> Result<(), SpatterError> {
+    let want_cpu = backends.is_empty() || backends.contains(&BackendChoice::Cpu);
+    let want_gpu = backends.is_empty() || backends.iter().any(|b| *b != BackendChoice::Cpu);
+    let mut rows = Vec::new();
+    println!("bench throughput: {SCENE_NAME}, {steps} timed steps per size after 2 warm-up steps");
+    for &target in sizes {
+        let l = scene_of_size(target)?;
+        let params = Params::new(&l.model, l.state.len() as u32);
+        let mut cpu = CpuBackend::new(params, l.state.clone());
+        cpu.prime();
+        let pairs = cpu.pair_count();
+        if want_cpu {
+            let mut cpu = CpuBackend::new(params, l.state.clone());
+            let mut row = measure(&l, &mut cpu, steps, pairs);
+            row.pass_ms = per_step(cpu.take_pass_times(), steps);
+            print_row(&row);
+            rows.push(row);
+        }
+        if want_gpu {
+            let Ok(ctx) = GpuContext::open(AdapterChoice::AnyGpu, false) else {
+                println!("gpu: no Vulkan adapter; skipped");
+                continue;
+            };
+            if ctx.is_software() && l.state.len() > SOFTWARE_MAX_PARTICLES {
+                println!(
+                    "{}: {} particles skipped (software adapter)",
+                    ctx.describe(),
+                    l.state.len()
+                );
+                continue;
+            }
+            let mut gpu =
+                GpuBackend::new(ctx, params, &l.state, false).map_err(SpatterError::Runtime)?;
+            let mut row = measure(&l, &mut gpu, steps, pairs);
+            // Per-pass times from a separate timestamped run: timestamps need one
+            // submission per step, which would slow the throughput figure.
+            if let Ok(ctx) = GpuContext::open(AdapterChoice::AnyGpu, true) {
+                if let Ok(mut prof) = GpuBackend::new(ctx, params, &l.state, true) {
+                    prof.prime();
+                    let k = steps.clamp(1, 5);
+                    prof.run_steps(k);
+                    row.pass_ms = per_step(prof.take_pass_times(), k);
+                }
+            }
+            print_row(&row);
+            rows.push(row);
+        }
+    }
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&rows)
+            .map_err(|e| SpatterError::Runtime(e.to_string()))?;
+        std::fs::write(path, text)
+            .map_err(|e| SpatterError::Runtime(format!("cannot write {path}: {e}")))?;
+        println!("wrote {path}");
+    }
+    Ok(())
+}
+
+fn print_row(r: &BenchRow) {
+    println!(
+        "{} | {} particles (dx {:.3e} m, {:.1} neighbours) | {:.3e} particle-steps/s | {:.3e} pair interactions/s | {:.3} s for {} steps",
+        r.backend, r.particles, r.dx, r.neighbours_per_fluid_particle, r.particle_steps_per_s, r.pair_interactions_per_s, r.wall_s, r.steps
+    );
+    if !r.pass_ms.is_empty() {
+        let parts: Vec<String> = r
+            .pass_ms
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.3}"))
+            .collect();
+        println!("    ms/step: {}", parts.join(", "));
+    }
+}

@@ -1,0 +1,15 @@
+//! spatter: SPH for additive-manufacturing process physics, with a GPU path (wgpu)
+//! and a bit-matched CPU reference path.
+
+pub mod backend;
+pub mod bench;
+pub mod checks;
+pub mod compare;
+pub mod error;
+pub mod kernel;
+pub mod model;
+pub mod params;
+pub mod run;
+pub mod scene;
+pub mod setup;
+pub mod state;

@@ -1,0 +1,507 @@
+//! A validated scene: every derived constant the solver needs, checked for physical
+//! sense, plus the host-side time-step limits (F22 (42)).
+
+use crate::error::InputError;
+use crate::scene::{CheckDef, Formulation, KernelKind, PhaseKind, SceneFile, Slip};
+
+#[derive(Debug, Clone)]
+pub struct PhaseInfo {
+    pub name: String,
+    pub kind: PhaseKind,
+    pub material: String,
+    pub rho0: f64,
+    pub sound_speed: f64,
+    pub viscosity: f64,
+    pub slip: Slip,
+    pub velocity: [f64; 3],
+    /// Particle mass ρ0 Δx^d (F22 Remark 2).
+    pub mass: f64,
+}
+
+impl PhaseInfo {
+    pub fn is_fluid(&self) -> bool {
+        self.kind != PhaseKind::Wall
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EndCondition {
+    Time(f64),
+    Steps(u64),
+}
+
+/// Host-side F22 (42) limits with zero velocity; the device recomputes the acoustic
+/// and force limits every step from the current maxima.
+#[derive(Debug, Clone, Copy)]
+pub struct DtLimits {
+    pub acoustic: f64,
+    pub viscous: f64,
+    pub body_force: f64,
+}
+
+impl DtLimits {
+    pub fn min(&self) -> (f64, &'static str) {
+        let mut best = (self.acoustic, "acoustic CFL 0.25 h/(c+|u|)");
+        if self.viscous < best.0 {
+            best = (self.viscous, "viscous 0.125 h^2/nu");
+        }
+        if self.body_force < best.0 {
+            best = (self.body_force, "body force 0.25 sqrt(h/|b|)");
+        }
+        best
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub file: String,
+    pub resolved_toml: String,
+    pub dim: u32,
+    pub formulation: Formulation,
+    pub kernel: KernelKind,
+    pub dx: f64,
+    pub h: f64,
+    pub support: f64,
+    pub domain_lo: [f64; 3],
+    pub domain_hi: [f64; 3],
+    /// Origin of the cell grid; particle positions are stored relative to it.
+    pub origin: [f64; 3],
+    pub periodic: [bool; 3],
+    pub grid: [u32; 3],
+    pub cell_size: [f64; 3],
+    pub wall_layers: u32,
+    pub gravity: [f64; 3],
+    pub background_pressure: f64,
+    pub pressure_floor: bool,
+    pub jitter: f64,
+    pub seed: u64,
+    pub phases: Vec<PhaseInfo>,
+    pub fixed_dt: Option<f64>,
+    pub end: EndCondition,
+    pub output_interval: f64,
+    pub check: Option<CheckDef>,
+    pub limits: DtLimits,
+}
+
+pub const MAX_PHASES: usize = 8;
+
+impl Model {
+    pub fn max_sound_speed(&self) -> f64 {
+        self.phases
+            .iter()
+            .filter(|p| p.is_fluid())
+            .map(|p| p.sound_speed)
+            .fold(0.0, f64::max)
+    }
+    pub fn max_kinematic_viscosity(&self) -> f64 {
+        self.phases
+            .iter()
+            .filter(|p| p.is_fluid())
+            .map(|p| p.viscosity / p.rho0)
+            .fold(0.0, f64::max)
+    }
+    pub fn n_cells(&self) -> u64 {
+        self.grid.iter().map(|&g| g as u64).product()
+    }
+    pub fn phase_index(&self, name: &str) -> Option<usize> {
+        self.phases.iter().position(|p| p.name == name)
+    }
+    /// Convert an absolute position to the stored (grid-relative) one.
+    pub fn to_local(&self, x: [f64; 3]) -> [f64; 3] {
+        [
+            x[0] - self.origin[0],
+            x[1] - self.origin[1],
+            x[2] - self.origin[2],
+        ]
+    }
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(&self, key: &str, msg: impl Into<String>) -> InputError {
+        InputError::new(self.file, key, msg)
+    }
+    fn positive(&self, key: &str, v: f64) -> Result<f64, InputError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("must be a positive finite number (got {v})")))
+        }
+    }
+    fn non_negative(&self, key: &str, v: f64) -> Result<f64, InputError> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("must be zero or positive (got {v})")))
+        }
+    }
+    fn vector(&self, key: &str, v: &[f64], dim: u32) -> Result<[f64; 3], InputError> {
+        if v.len() != dim as usize {
+            return Err(self.err(
+                key,
+                format!(
+                    "needs {dim} components for a {dim}D scene (got {})",
+                    v.len()
+                ),
+            ));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(self.err(key, "components must be finite numbers"));
+        }
+        let mut out = [0.0; 3];
+        out[..v.len()].copy_from_slice(v);
+        Ok(out)
+    }
+}
+
+/// Validate a parsed scene and derive all constants.
+pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model, InputError> {
+    let cx = Ctx { file };
+    let sim = &scene.simulation;
+    if sim.dimension != 2 && sim.dimension != 3 {
+        return Err(cx.err(
+            "simulation.dimension",
+            format!("must be 2 or 3 (got {})", sim.dimension),
+        ));
+    }
+    let dim = sim.dimension;
+    let dx = cx.positive("simulation.dx", sim.dx)?;
+    let h_over_dx = sim.h_over_dx.unwrap_or(sim.kernel.default_h_over_dx());
+    cx.positive("simulation.h_over_dx", h_over_dx)?;
+    if !(0.5..=3.0).contains(&h_over_dx) {
+        return Err(cx.err(
+            "simulation.h_over_dx",
+            format!("must lie in [0.5, 3] (got {h_over_dx})"),
+        ));
+    }
+    let h = h_over_dx * dx;
+    let support = sim.kernel.support_factor() * h;
+    let gravity = if sim.gravity.is_empty() {
+        [0.0; 3]
+    } else {
+        cx.vector("simulation.gravity", &sim.gravity, dim)?
+    };
+    cx.non_negative("simulation.background_pressure", sim.background_pressure)?;
+    if !(0.0..=0.5).contains(&sim.jitter) {
+        return Err(cx.err(
+            "simulation.jitter",
+            format!("must lie in [0, 0.5] (fraction of dx, got {})", sim.jitter),
+        ));
+    }
+
+    let (domain_lo, domain_hi, periodic) = domain_box(&cx, scene, dim)?;
+    let phases = phase_table(&cx, scene, dim, dx)?;
+    let wall_layers = (support / dx - 1e-9).ceil() as u32;
+    let (origin, grid, cell_size) = cell_grid(
+        &cx,
+        dim,
+        domain_lo,
+        domain_hi,
+        periodic,
+        support,
+        dx,
+        wall_layers,
+    )?;
+    check_walls(&cx, scene, &phases, dim, periodic)?;
+
+    let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
+    if fluid.is_empty() {
+        return Err(cx.err("phases", "the scene has no liquid or gas phase"));
+    }
+    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    let nu_max = fluid
+        .iter()
+        .map(|p| p.viscosity / p.rho0)
+        .fold(0.0, f64::max);
+    let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
+    let limits = DtLimits {
+        acoustic: 0.25 * h / c_max,
+        viscous: if nu_max > 0.0 {
+            0.125 * h * h / nu_max
+        } else {
+            f64::INFINITY
+        },
+        body_force: if g > 0.0 {
+            0.25 * (h / g).sqrt()
+        } else {
+            f64::INFINITY
+        },
+    };
+
+    let run = &scene.run;
+    let fixed_dt = match run.dt {
+        Some(dt) => {
+            cx.positive("run.dt", dt)?;
+            let (lim, which) = limits.min();
+            if dt > lim {
+                return Err(cx.err(
+                    "run.dt",
+                    format!(
+                        "fixed time step {dt:e} s exceeds the stability limit {lim:e} s ({which})"
+                    ),
+                ));
+            }
+            Some(dt)
+        }
+        None => None,
+    };
+    let end = match (run.end_time, run.steps) {
+        (Some(_), Some(_)) => return Err(cx.err("run", "give end_time or steps, not both")),
+        (Some(t), None) => EndCondition::Time(cx.positive("run.end_time", t)?),
+        (None, Some(n)) => EndCondition::Steps(n),
+        (None, None) => return Err(cx.err("run", "needs end_time or steps")),
+    };
+    let output_interval = match run.output_interval {
+        Some(v) => cx.positive("run.output_interval", v)?,
+        None => match end {
+            EndCondition::Time(t) => t / 20.0,
+            EndCondition::Steps(_) => f64::INFINITY,
+        },
+    };
+    if let Some(c) = &scene.check {
+        cx.positive("check.tolerance", c.tolerance)?;
+    }
+
+    Ok(Model {
+        file: file.to_string(),
+        resolved_toml: resolved_toml.to_string(),
+        dim,
+        formulation: sim.formulation,
+        kernel: sim.kernel,
+        dx,
+        h,
+        support,
+        domain_lo,
+        domain_hi,
+        origin,
+        periodic,
+        grid,
+        cell_size,
+        wall_layers,
+        gravity,
+        background_pressure: sim.background_pressure,
+        pressure_floor: sim.pressure_floor,
+        jitter: sim.jitter,
+        seed: sim.seed,
+        phases,
+        fixed_dt,
+        end,
+        output_interval,
+        check: scene.check.clone(),
+        limits,
+    })
+}
+
+fn domain_box(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+) -> Result<([f64; 3], [f64; 3], [bool; 3]), InputError> {
+    let lo = cx.vector("domain.min", &scene.domain.min, dim)?;
+    let hi = cx.vector("domain.max", &scene.domain.max, dim)?;
+    for a in 0..dim as usize {
+        if hi[a] <= lo[a] {
+            return Err(cx.err(
+                "domain.max",
+                format!("must exceed domain.min on every axis (axis {a})"),
+            ));
+        }
+    }
+    let mut periodic = [false; 3];
+    if !scene.domain.periodic.is_empty() {
+        if scene.domain.periodic.len() != dim as usize {
+            return Err(cx.err("domain.periodic", format!("needs {dim} entries")));
+        }
+        periodic[..dim as usize].copy_from_slice(&scene.domain.periodic);
+    }
+    Ok((lo, hi, periodic))
+}
+
+fn phase_table(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+    dx: f64,
+) -> Result<Vec<PhaseInfo>, InputError> {
+    if scene.phases.len() > MAX_PHASES {
+        return Err(cx.err(
+            "phases",
+            format!("at most {MAX_PHASES} phases are supported"),
+        ));
+    }
+    let mut out = Vec::new();
+    for (name, p) in &scene.phases {
+        let key = |k: &str| format!("phases.{name}.{k}");
+        let Some(mat) = scene.materials.get(&p.material) else {
+            return Err(cx.err(
+                &key("material"),
+                format!("no material named `{}`", p.material),
+            ));
+        };
+        let mkey = |k: &str| format!("materials.{}.{k}", p.material);
+        let rho0 = cx.positive(&mkey("density"), mat.density)?;
+        let viscosity = cx.non_negative(&mkey("viscosity"), mat.viscosity)?;
+        let sound_speed = match (mat.sound_speed, mat.reference_pressure) {
+            (Some(c), None) => cx.positive(&mkey("sound_speed"), c)?,
+            (None, Some(p0)) => (cx.positive(&mkey("reference_pressure"), p0)? / rho0).sqrt(),
+            (Some(_), Some(_)) => {
+                return Err(cx.err(
+                    &mkey("sound_speed"),
+                    "give sound_speed or reference_pressure, not both",
+                ))
+            }
+            (None, None) => {
+                return Err(cx.err(
+                    &mkey("sound_speed"),
+                    "missing: give sound_speed or reference_pressure",
+                ))
+            }
+        };
+        let velocity = match &p.velocity {
+            Some(v) if p.kind == PhaseKind::Wall => cx.vector(&key("velocity"), v, dim)?,
+            Some(_) => {
+                return Err(cx.err(
+                    &key("velocity"),
+                    "only wall phases take a prescribed velocity",
+                ))
+            }
+            None => [0.0; 3],
+        };
+        out.push(PhaseInfo {
+            name: name.clone(),
+            kind: p.kind,
+            material: p.material.clone(),
+            rho0,
+            sound_speed,
+            viscosity,
+            slip: p.slip,
+            velocity,
+            mass: rho0 * dx.powi(dim as i32),
+        });
+    }
+    Ok(out)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn cell_grid(
+    cx: &Ctx,
+    dim: u32,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    periodic: [bool; 3],
+    support: f64,
+    dx: f64,
+    wall_layers: u32,
+) -> Result<([f64; 3], [u32; 3], [f64; 3]), InputError> {
+    let mut origin = [0.0; 3];
+    let mut grid = [1u32; 3];
+    let mut cell = [1.0; 3];
+    for a in 0..dim as usize {
+        let len = hi[a] - lo[a];
+        if periodic[a] {
+            // Cells tile the period exactly so wrapped neighbours land in whole cells.
+            let n = (len / support).floor();
+            if n < 3.0 {
+                return Err(cx.err(
+                    "domain.max",
+                    format!("periodic axis {a} must span at least 3 kernel supports ({:.3e} m), got {len:.3e} m", 3.0 * support),
+                ));
+            }
+            let sites = len / dx;
+            if (sites - sites.round()).abs() > 1e-6 * sites.max(1.0) {
+                return Err(cx.err(
+                    "simulation.dx",
+                    format!("periodic length {len:e} m along axis {a} is not a multiple of dx"),
+                ));
+            }
+            origin[a] = lo[a];
+            grid[a] = n as u32;
+            cell[a] = len / n;
+        } else {
+            let pad = (wall_layers as f64 + 1.0) * dx;
+            origin[a] = lo[a] - pad;
+            let n = ((len + 2.0 * pad) / support).ceil().max(1.0);
+            if n > 1.0e6 {
+                return Err(cx.err(
+                    "simulation.dx",
+                    format!("cell grid too large along axis {a} ({n} cells)"),
+                ));
+            }
+            grid[a] = n as u32;
+            cell[a] = support;
+        }
+    }
+    let total: f64 = grid.iter().map(|&g| g as f64).product();
+    if total > 4.0e8 {
+        return Err(cx.err(
+            "simulation.dx",
+            format!("cell grid of {total:e} cells does not fit in memory"),
+        ));
+    }
+    Ok((origin, grid, cell))
+}
+
+fn check_walls(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &[PhaseInfo],
+    dim: u32,
+    periodic: [bool; 3],
+) -> Result<(), InputError> {
+    let is_wall = |name: &str| {
+        phases
+            .iter()
+            .any(|p| p.name == name && p.kind == PhaseKind::Wall)
+    };
+    let needs_walls = (0..dim as usize).any(|a| !periodic[a]);
+    match &scene.domain.wall_phase {
+        Some(w) if !is_wall(w) => {
+            return Err(cx.err(
+                "domain.wall_phase",
+                format!("`{w}` is not a phase of kind \"wall\""),
+            ))
+        }
+        None if needs_walls => {
+            return Err(cx.err(
+                "domain.wall_phase",
+                "a domain with a non-periodic axis needs wall_phase",
+            ))
+        }
+        _ => {}
+    }
+    const SIDES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"];
+    for side in &scene.domain.open_sides {
+        let key = "domain.open_sides";
+        let Some(i) = SIDES.iter().position(|s| s == side) else {
+            return Err(cx.err(
+                key,
+                format!("unknown side `{side}` (use x_min, x_max, y_min, y_max, z_min, z_max)"),
+            ));
+        };
+        if i / 2 >= dim as usize || periodic[i / 2] {
+            return Err(cx.err(
+                key,
+                format!("side `{side}` has no wall to open (axis absent or periodic)"),
+            ));
+        }
+    }
+    for (side, w) in &scene.domain.wall_sides {
+        let key = format!("domain.wall_sides.{side}");
+        let Some(i) = SIDES.iter().position(|s| s == side) else {
+            return Err(cx.err(
+                &key,
+                "unknown side (use x_min, x_max, y_min, y_max, z_min, z_max)",
+            ));
+        };
+        if i / 2 >= dim as usize || periodic[i / 2] {
+            return Err(cx.err(&key, "this side has no wall (axis absent or periodic)"));
+        }
+        if !is_wall(w) {
+            return Err(cx.err(&key, format!("`{w}` is not a phase of kind \"wall\"")));
+        }
+    }
+    Ok(())
+}

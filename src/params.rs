@@ -1,0 +1,150 @@
+//! The f32 parameter block both backends read (DESIGN rule 6): computed once on the
+//! host in f64 and rounded to f32, so the CPU twin and the WGSL pass see the same bits.
+
+use crate::model::{Model, MAX_PHASES};
+use crate::scene::{KernelKind, PhaseKind, Slip};
+use bytemuck::{Pod, Zeroable};
+use std::f64::consts::PI;
+
+pub const FLAG_PERIODIC_X: u32 = 1;
+pub const FLAG_PERIODIC_Y: u32 = 2;
+pub const FLAG_PERIODIC_Z: u32 = 4;
+pub const FLAG_PRESSURE_FLOOR: u32 = 8;
+
+pub const KIND_LIQUID: f32 = 0.0;
+pub const KIND_GAS: f32 = 1.0;
+pub const KIND_WALL: f32 = 2.0;
+
+/// Mirrors `struct Params` in shaders/common.wgsl field for field.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct Params {
+    /// n_particles, n_cells, dimension, kernel code (0 quintic, 1 Wendland C2, 2 cubic).
+    pub counts: [u32; 4],
+    /// cells along x, y, z; flags (periodic axes, pressure floor).
+    pub grid: [u32; 4],
+    /// 1 / cell size per axis.
+    pub cell_inv: [f32; 4],
+    /// Period length per axis (0 where not periodic).
+    pub period: [f32; 4],
+    /// Half the period per axis, for the minimum-image test.
+    pub half_period: [f32; 4],
+    /// h, 1/h, kernel normalisation σ, support radius squared.
+    pub kernel: [f32; 4],
+    /// Gravity xyz, background pressure p_b.
+    pub gravity: [f32; 4],
+    /// h, max sound speed, viscous limit 0.125 h²/ν (f32::MAX if inviscid), fixed Δt (0: adaptive).
+    pub dt: [f32; 4],
+    /// Per phase: ρ0, c², η, kind (0 liquid, 1 gas, 2 wall).
+    pub phase_a: [[f32; 4]; MAX_PHASES],
+    /// Per phase: wall velocity xyz, slip (0 no-slip, 1 free-slip).
+    pub phase_b: [[f32; 4]; MAX_PHASES],
+    /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
+    /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
+    /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
+    /// shaders read every multiplying or adding literal from here.
+    pub consts: [[f32; 4]; 4],
+}
+
+/// Mirrors the `c_*` functions in shaders/common.wgsl.
+pub const SHADER_CONSTS: [[f32; 4]; 4] = [
+    [0.5, 0.25, 2.0, 1.0],
+    [3.0, 6.0, 15.0, 5.0],
+    [30.0, 75.0, 1.5, 0.75],
+    [2.25, 0.0, 0.0, 0.0],
+];
+
+/// Kernel normalisation σ so that ∫W = 1 (Morris 1997 quintic, Wendland C2, cubic spline).
+pub fn kernel_sigma(kind: KernelKind, dim: u32, h: f64) -> f64 {
+    let hd = h.powi(dim as i32);
+    let s = match (kind, dim) {
+        (KernelKind::Quintic, 2) => 7.0 / (478.0 * PI),
+        (KernelKind::Quintic, _) => 3.0 / (359.0 * PI),
+        (KernelKind::WendlandC2, 2) => 7.0 / (4.0 * PI),
+        (KernelKind::WendlandC2, _) => 21.0 / (16.0 * PI),
+        (KernelKind::Cubic, 2) => 10.0 / (7.0 * PI),
+        (KernelKind::Cubic, _) => 1.0 / PI,
+    };
+    s / hd
+}
+
+impl Params {
+    pub fn new(m: &Model, n_particles: u32) -> Params {
+        let mut flags = 0;
+        let mut period = [0.0f32; 4];
+        let mut half = [0.0f32; 4];
+        for a in 0..3 {
+            if m.periodic[a] {
+                flags |= 1 << a;
+                let len = m.domain_hi[a] - m.domain_lo[a];
+                period[a] = len as f32;
+                half[a] = (0.5 * len) as f32;
+            }
+        }
+        if m.pressure_floor {
+            flags |= FLAG_PRESSURE_FLOOR;
+        }
+        let mut phase_a = [[0.0f32; 4]; MAX_PHASES];
+        let mut phase_b = [[0.0f32; 4]; MAX_PHASES];
+        for (i, ph) in m.phases.iter().enumerate() {
+            let kind = match ph.kind {
+                PhaseKind::Liquid => KIND_LIQUID,
+                PhaseKind::Gas => KIND_GAS,
+                PhaseKind::Wall => KIND_WALL,
+            };
+            let c2 = ph.sound_speed * ph.sound_speed;
+            phase_a[i] = [ph.rho0 as f32, c2 as f32, ph.viscosity as f32, kind];
+            let slip = if ph.slip == Slip::FreeSlip { 1.0 } else { 0.0 };
+            phase_b[i] = [
+                ph.velocity[0] as f32,
+                ph.velocity[1] as f32,
+                ph.velocity[2] as f32,
+                slip,
+            ];
+        }
+        let viscous = if m.limits.viscous.is_finite() {
+            m.limits.viscous as f32
+        } else {
+            f32::MAX
+        };
+        Params {
+            counts: [n_particles, m.n_cells() as u32, m.dim, m.kernel.code()],
+            grid: [m.grid[0], m.grid[1], m.grid[2], flags],
+            cell_inv: [
+                (1.0 / m.cell_size[0]) as f32,
+                (1.0 / m.cell_size[1]) as f32,
+                (1.0 / m.cell_size[2]) as f32,
+                0.0,
+            ],
+            period,
+            half_period: half,
+            kernel: [
+                m.h as f32,
+                (1.0 / m.h) as f32,
+                kernel_sigma(m.kernel, m.dim, m.h) as f32,
+                (m.support * m.support) as f32,
+            ],
+            gravity: [
+                m.gravity[0] as f32,
+                m.gravity[1] as f32,
+                m.gravity[2] as f32,
+                m.background_pressure as f32,
+            ],
+            dt: [
+                m.h as f32,
+                m.max_sound_speed() as f32,
+                viscous,
+                m.fixed_dt.unwrap_or(0.0) as f32,
+            ],
+            phase_a,
+            phase_b,
+            consts: SHADER_CONSTS,
+        }
+    }
+    pub fn n(&self) -> usize {
+        self.counts[0] as usize
+    }
+    pub fn is_wall(&self, phase: u32) -> bool {
+        self.phase_a[phase as usize][3] == KIND_WALL
+    }
+}

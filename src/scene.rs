@@ -1,0 +1,375 @@
+//! Scenario files: the TOML format, `--set` overrides and validation.
+//!
+//! Parsing is strict: unknown keys are errors, every physical value is checked for
+//! sign and range, and each message names the file and the dotted key.
+
+use crate::error::InputError;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KernelKind {
+    Quintic,
+    WendlandC2,
+    Cubic,
+}
+
+impl KernelKind {
+    /// Support radius in units of h.
+    pub fn support_factor(self) -> f64 {
+        match self {
+            KernelKind::Quintic => 3.0,
+            KernelKind::WendlandC2 | KernelKind::Cubic => 2.0,
+        }
+    }
+    /// Default h/Δx: F22 uses h = Δx for the quintic spline; R18 h = 1.2Δx for
+    /// Wendland C2; the cubic spline with h = Δx (support 2Δx) matches SPlisHSPlasH.
+    pub fn default_h_over_dx(self) -> f64 {
+        match self {
+            KernelKind::Quintic => 1.0,
+            KernelKind::WendlandC2 => 1.2,
+            KernelKind::Cubic => 1.0,
+        }
+    }
+    pub fn code(self) -> u32 {
+        match self {
+            KernelKind::Quintic => 0,
+            KernelKind::WendlandC2 => 1,
+            KernelKind::Cubic => 2,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelKind::Quintic => "quintic",
+            KernelKind::WendlandC2 => "wendland_c2",
+            KernelKind::Cubic => "cubic",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    Wcsph,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PhaseKind {
+    Liquid,
+    Gas,
+    Wall,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Slip {
+    #[default]
+    NoSlip,
+    FreeSlip,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub simulation: Simulation,
+    pub domain: Domain,
+    pub materials: BTreeMap<String, Material>,
+    pub phases: BTreeMap<String, PhaseDef>,
+    #[serde(default)]
+    pub shapes: Vec<ShapeDef>,
+    #[serde(default)]
+    pub run: RunDef,
+    pub check: Option<CheckDef>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    pub dimension: u32,
+    #[serde(default = "default_formulation")]
+    pub formulation: Formulation,
+    #[serde(default = "default_kernel")]
+    pub kernel: KernelKind,
+    pub h_over_dx: Option<f64>,
+    pub dx: f64,
+    #[serde(default)]
+    pub gravity: Vec<f64>,
+    /// Transport-velocity background pressure p_b in Pa (F22 §4.1: 5 p0); 0 switches
+    /// the transport-velocity correction off.
+    #[serde(default)]
+    pub background_pressure: f64,
+    /// Clamp the equation of state at p >= 0. Needed for single-phase free surfaces,
+    /// where summation density is deficient near the surface (PHYSICS.md §2a).
+    #[serde(default)]
+    pub pressure_floor: bool,
+    /// Seeded random displacement of fluid particles, as a fraction of Δx.
+    #[serde(default)]
+    pub jitter: f64,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_formulation() -> Formulation {
+    Formulation::Wcsph
+}
+fn default_kernel() -> KernelKind {
+    KernelKind::Quintic
+}
+fn default_seed() -> u64 {
+    1
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Domain {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+    #[serde(default)]
+    pub periodic: Vec<bool>,
+    /// Phase of the wall layers put around every non-periodic side.
+    pub wall_phase: Option<String>,
+    /// Per-side override of the wall phase: keys x_min, x_max, y_min, y_max, z_min, z_max.
+    #[serde(default)]
+    pub wall_sides: BTreeMap<String, String>,
+    /// Sides left open (no wall layers), e.g. ["z_max"] above a free surface.
+    /// Particles may leave through them; the cell grid clamps them into its edge cells.
+    #[serde(default)]
+    pub open_sides: Vec<String>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Reference density ρ0 in kg/m³.
+    pub density: f64,
+    /// Dynamic viscosity η in Pa·s.
+    pub viscosity: f64,
+    /// Speed of sound c in m/s; give this or `reference_pressure`.
+    pub sound_speed: Option<f64>,
+    /// Reference pressure p0 = ρ0 c² in Pa (F22 §4.1 uses 1e7 Pa).
+    pub reference_pressure: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseDef {
+    pub kind: PhaseKind,
+    pub material: String,
+    #[serde(default)]
+    pub slip: Slip,
+    /// Prescribed velocity of a wall phase (m/s); walls do not move in position.
+    pub velocity: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDef {
+    pub phase: String,
+    #[serde(rename = "box")]
+    pub box_: Option<BoxDef>,
+    pub sphere: Option<SphereDef>,
+    pub cylinder: Option<CylinderDef>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxDef {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDef {
+    pub center: Vec<f64>,
+    pub radius: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderDef {
+    /// Centre of one end face.
+    pub base: Vec<f64>,
+    /// Axis from the base face to the other face; its length is the cylinder's length.
+    pub axis: Vec<f64>,
+    pub radius: f64,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunDef {
+    pub end_time: Option<f64>,
+    pub steps: Option<u64>,
+    /// Fixed time step; absent means adaptive from the F22 (42) limits.
+    pub dt: Option<f64>,
+    /// Simulated time between state samples (checks, output frames).
+    pub output_interval: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckDef {
+    pub kind: CheckKind,
+    pub tolerance: f64,
+    /// Hydrostatic: initial free-surface height. Two-layer: interface height.
+    pub surface: Option<f64>,
+    /// Dam break: initial column width L.
+    pub column_width: Option<f64>,
+    /// Hydrostatic: particles closer than this to the free surface are excluded (m).
+    pub exclude_depth: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckKind {
+    Hydrostatic,
+    Poiseuille,
+    Couette,
+    DamBreakFront,
+    TwoLayer,
+}
+
+/// Read a scenario file, apply `--set` overrides and parse it strictly.
+pub fn load(path: &str, overrides: &[String]) -> Result<(SceneFile, String), InputError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read scenario: {e}")))?;
+    parse_str(path, &text, overrides)
+}
+
+/// Parse scenario text (named `file` in messages). Returns the scene and the resolved
+/// TOML text after overrides, which is what a run records for reproduction.
+pub fn parse_str(
+    file: &str,
+    text: &str,
+    overrides: &[String],
+) -> Result<(SceneFile, String), InputError> {
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| InputError::new(file, "", describe(&e, text)))?;
+    for ov in overrides {
+        apply_override(file, &mut table, ov)?;
+    }
+    let resolved = toml::to_string(&table).unwrap_or_default();
+    // Spans point into the user's own file when there are no overrides.
+    let src = if overrides.is_empty() {
+        text
+    } else {
+        resolved.as_str()
+    };
+    let scene: SceneFile = toml::from_str(src)
+        .map_err(|e| InputError::new(file, &error_key_from_text(&e, src), describe(&e, src)))?;
+    Ok((scene, resolved))
+}
+
+fn describe(e: &toml::de::Error, text: &str) -> String {
+    let msg = e.message().trim().to_string();
+    match e.span() {
+        Some(span) => {
+            let line = text[..span.start.min(text.len())].lines().count().max(1);
+            format!("{msg} (line {line})")
+        }
+        None => msg,
+    }
+}
+
+fn error_key_from_text(e: &toml::de::Error, text: &str) -> String {
+    let Some(span) = e.span() else {
+        return String::new();
+    };
+    let upto = &text[..span.start.min(text.len())];
+    let mut section = String::new();
+    for line in upto.lines() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            section = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+        }
+    }
+    let line = upto.lines().last().unwrap_or("");
+    let rest = &text[span.start.min(text.len())..];
+    let full_line = format!("{line}{}", rest.lines().next().unwrap_or(""));
+    let key = full_line
+        .split('=')
+        .next()
+        .unwrap_or("")
+        .trim()
+        .trim_matches('"');
+    let key_ok = !key.is_empty() && !key.starts_with('[') && !key.contains(' ');
+    match (section.is_empty(), key_ok) {
+        (true, true) => key.to_string(),
+        (false, true) => format!("{section}.{key}"),
+        (false, false) => section,
+        (true, false) => String::new(),
+    }
+}
+
+/// Sections searched, in order, for a bare `--set name=value`.
+const ALIAS_SECTIONS: [&str; 4] = ["simulation", "run", "domain", "check"];
+
+fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), InputError> {
+    let Some((key, raw)) = ov.split_once('=') else {
+        return Err(InputError::new(file, ov, "--set expects key=value"));
+    };
+    let key = key.trim();
+    let value = parse_value(raw.trim());
+    let path: Vec<String> = if key.contains('.') {
+        key.split('.').map(str::to_string).collect()
+    } else {
+        let hits: Vec<&str> = ALIAS_SECTIONS
+            .iter()
+            .copied()
+            .filter(|s| {
+                table
+                    .get(*s)
+                    .and_then(|t| t.as_table())
+                    .is_some_and(|t| t.contains_key(key))
+            })
+            .collect();
+        match hits.as_slice() {
+            [one] => vec![one.to_string(), key.to_string()],
+            [] => {
+                // Not present yet: an optional key of [run] or [simulation].
+                let section = if RUN_KEYS.contains(&key) {
+                    "run"
+                } else {
+                    "simulation"
+                };
+                vec![section.to_string(), key.to_string()]
+            }
+            _ => {
+                return Err(InputError::new(
+                    file,
+                    key,
+                    format!(
+                        "--set: ambiguous key, found in sections {}; write section.key",
+                        hits.join(", ")
+                    ),
+                ))
+            }
+        }
+    };
+    let mut node = table;
+    for seg in &path[..path.len() - 1] {
+        let entry = node
+            .entry(seg.clone())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        node = entry
+            .as_table_mut()
+            .ok_or_else(|| InputError::new(file, key, format!("--set: `{seg}` is not a table")))?;
+    }
+    node.insert(path[path.len() - 1].clone(), value);
+    Ok(())
+}
+
+const RUN_KEYS: [&str; 4] = ["end_time", "steps", "dt", "output_interval"];
+
+fn parse_value(raw: &str) -> toml::Value {
+    let doc = format!("v = {raw}");
+    match doc.parse::<toml::Table>() {
+        Ok(mut t) => t
+            .remove("v")
+            .unwrap_or(toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    }
+}

@@ -1,0 +1,296 @@
+//! Initial particles: a lattice fill of the scene's shapes plus wall layers.
+//!
+//! Lattice sites sit at cell centres lo + (i + ½)Δx inside the domain and at
+//! lo − (k + ½)Δx, hi + (k + ½)Δx in the wall layers. Later shapes override earlier
+//! ones at the same site, so "gas everywhere, then liquid in a box" works.
+
+use crate::error::InputError;
+use crate::model::Model;
+use crate::scene::{SceneFile, ShapeDef};
+use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE};
+
+/// Lattice coordinates along one axis: positions and whether each is in a wall layer.
+fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
+    if a >= m.dim as usize {
+        return vec![(0.0, false)];
+    }
+    let (lo, hi, dx) = (m.domain_lo[a], m.domain_hi[a], m.dx);
+    let n = ((hi - lo) / dx + 1e-9).floor() as i64;
+    let mut out: Vec<(f64, bool)> = Vec::with_capacity(n as usize + 2 * m.wall_layers as usize);
+    let walls = if m.periodic[a] {
+        0
+    } else {
+        m.wall_layers as i64
+    };
+    for k in (0..walls).rev() {
+        out.push((lo - (k as f64 + 0.5) * dx, true));
+    }
+    for i in 0..n {
+        out.push((lo + (i as f64 + 0.5) * dx, false));
+    }
+    for k in 0..walls {
+        out.push((hi + (k as f64 + 0.5) * dx, true));
+    }
+    out
+}
+
+/// Upper bound of the particle count (every lattice site occupied), for the memory
+/// check before anything is allocated.
+pub fn site_count(m: &Model) -> f64 {
+    (0..3).map(|a| axis_sites_len(m, a)).product()
+}
+
+fn axis_sites_len(m: &Model, a: usize) -> f64 {
+    if a >= m.dim as usize {
+        return 1.0;
+    }
+    let n = ((m.domain_hi[a] - m.domain_lo[a]) / m.dx + 1e-9).floor();
+    let walls = if m.periodic[a] {
+        0.0
+    } else {
+        2.0 * m.wall_layers as f64
+    };
+    n + walls
+}
+
+/// Estimated memory of the scene in bytes.
+pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
+    particles * BYTES_PER_PARTICLE as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
+}
+
+/// Memory this machine has free, from /proc/meminfo (None where unknown).
+pub fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+fn inside(shape: &ShapeDef, x: [f64; 3], dim: usize) -> bool {
+    if let Some(b) = &shape.box_ {
+        return (0..dim).all(|a| x[a] >= b.min[a] && x[a] <= b.max[a]);
+    }
+    if let Some(s) = &shape.sphere {
+        let d2: f64 = (0..dim).map(|a| (x[a] - s.center[a]).powi(2)).sum();
+        return d2 <= s.radius * s.radius;
+    }
+    if let Some(c) = &shape.cylinder {
+        let len2: f64 = (0..dim).map(|a| c.axis[a] * c.axis[a]).sum();
+        let t: f64 = (0..dim)
+            .map(|a| (x[a] - c.base[a]) * c.axis[a])
+            .sum::<f64>()
+            / len2;
+        if !(0.0..=1.0).contains(&t) {
+            return false;
+        }
+        let d2: f64 = (0..dim)
+            .map(|a| (x[a] - c.base[a] - t * c.axis[a]).powi(2))
+            .sum();
+        return d2 <= c.radius * c.radius;
+    }
+    false
+}
+
+fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputError> {
+    let dim = m.dim as usize;
+    let mut phase_of = Vec::new();
+    for (i, s) in scene.shapes.iter().enumerate() {
+        let key = |k: &str| format!("shapes[{i}].{k}");
+        let Some(pi) = m.phase_index(&s.phase) else {
+            return Err(InputError::new(
+                &m.file,
+                &key("phase"),
+                format!("no phase named `{}`", s.phase),
+            ));
+        };
+        let count =
+            s.box_.is_some() as u32 + s.sphere.is_some() as u32 + s.cylinder.is_some() as u32;
+        if count != 1 {
+            return Err(InputError::new(
+                &m.file,
+                &format!("shapes[{i}]"),
+                "give exactly one of box, sphere, cylinder",
+            ));
+        }
+        let vec_ok = |v: &[f64]| v.len() == dim && v.iter().all(|x| x.is_finite());
+        let (lo, hi, which) = if let Some(b) = &s.box_ {
+            if !vec_ok(&b.min) || !vec_ok(&b.max) {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("box"),
+                    format!("min and max need {dim} finite components"),
+                ));
+            }
+            if (0..dim).any(|a| b.max[a] <= b.min[a]) {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("box.max"),
+                    "must exceed box.min on every axis",
+                ));
+            }
+            (b.min.clone(), b.max.clone(), "box")
+        } else if let Some(sp) = &s.sphere {
+            if !vec_ok(&sp.center) || !(sp.radius > 0.0) {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("sphere"),
+                    format!("needs a {dim}-component center and a positive radius"),
+                ));
+            }
+            let lo = (0..dim).map(|a| sp.center[a] - sp.radius).collect();
+            let hi = (0..dim).map(|a| sp.center[a] + sp.radius).collect();
+            (lo, hi, "sphere")
+        } else {
+            let c = s.cylinder.as_ref().unwrap();
+            let len2: f64 = c.axis.iter().map(|v| v * v).sum();
+            if !vec_ok(&c.base) || !vec_ok(&c.axis) || !(c.radius > 0.0) || !(len2 > 0.0) {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("cylinder"),
+                    format!("needs {dim}-component base and non-zero axis, positive radius"),
+                ));
+            }
+            let lo = (0..dim)
+                .map(|a| c.base[a].min(c.base[a] + c.axis[a]) - c.radius)
+                .collect();
+            let hi = (0..dim)
+                .map(|a| c.base[a].max(c.base[a] + c.axis[a]) + c.radius)
+                .collect();
+            (lo, hi, "cylinder")
+        };
+        // A fluid shape must lie in the domain: particles outside would start in the walls.
+        if m.phases[pi].is_fluid() {
+            let tol = 1e-9 * m.dx;
+            for a in 0..dim {
+                if lo[a] < m.domain_lo[a] - tol || hi[a] > m.domain_hi[a] + tol {
+                    return Err(InputError::new(
+                        &m.file,
+                        &key(which),
+                        format!("fluid shape extends outside the domain along axis {a} ([{}, {}] vs domain [{}, {}])", lo[a], hi[a], m.domain_lo[a], m.domain_hi[a]),
+                    ));
+                }
+            }
+        }
+        phase_of.push(pi);
+    }
+    Ok(phase_of)
+}
+
+/// A small deterministic generator (SplitMix64) for the optional jitter; its output
+/// is fixed by the seed on every platform.
+struct SplitMix(u64);
+impl SplitMix {
+    fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn wall_phase_at(m: &Model, scene: &SceneFile, x: [f64; 3]) -> Option<usize> {
+    const SIDES: [[&str; 2]; 3] = [["x_min", "x_max"], ["y_min", "y_max"], ["z_min", "z_max"]];
+    for a in 0..m.dim as usize {
+        let side = if x[a] < m.domain_lo[a] {
+            0
+        } else if x[a] > m.domain_hi[a] {
+            1
+        } else {
+            continue;
+        };
+        if scene.domain.open_sides.iter().any(|s| s == SIDES[a][side]) {
+            return None;
+        }
+        let name = scene
+            .domain
+            .wall_sides
+            .get(SIDES[a][side])
+            .or(scene.domain.wall_phase.as_ref())?;
+        return m.phase_index(name);
+    }
+    None
+}
+
+/// Generate the initial particles. Fails if the scene would not fit in memory or has
+/// no fluid particle.
+pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
+    let sites = site_count(m);
+    let bytes = memory_estimate(m, sites);
+    if let Some(avail) = available_memory() {
+        if bytes > 0.8 * avail {
+            return Err(InputError::new(
+                &m.file,
+                "simulation.dx",
+                format!("scene needs about {:.1} GiB for up to {sites:.3e} particles but {:.1} GiB is free; use a larger dx", bytes / 1073741824.0, avail / 1073741824.0),
+            ));
+        }
+    }
+    if sites > u32::MAX as f64 / 2.0 {
+        return Err(InputError::new(
+            &m.file,
+            "simulation.dx",
+            format!("{sites:e} lattice sites exceed the 2^31 particle limit"),
+        ));
+    }
+    let shape_phase = validate_shapes(m, scene)?;
+    let axes: Vec<Vec<(f64, bool)>> = (0..3).map(|a| axis_sites(m, a)).collect();
+    let mut rng = SplitMix(m.seed);
+    let mut st = State::default();
+    for &(z, wz) in &axes[2] {
+        for &(y, wy) in &axes[1] {
+            for &(x, wx) in &axes[0] {
+                let p = [x, y, z];
+                let phase = if wx || wy || wz {
+                    wall_phase_at(m, scene, p)
+                } else {
+                    scene
+                        .shapes
+                        .iter()
+                        .zip(&shape_phase)
+                        .rev()
+                        .find(|(s, _)| inside(s, p, m.dim as usize))
+                        .map(|(_, &pi)| pi)
+                };
+                let Some(pi) = phase else { continue };
+                let mut q = p;
+                if m.jitter > 0.0 && m.phases[pi].is_fluid() {
+                    for c in q.iter_mut().take(m.dim as usize) {
+                        *c += (rng.next_f64() - 0.5) * 2.0 * m.jitter * m.dx;
+                    }
+                }
+                push_particle(m, &mut st, q, pi);
+            }
+        }
+    }
+    if !st.phase.iter().any(|&p| m.phases[p as usize].is_fluid()) {
+        return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid particle (no shape of a liquid or gas phase covers a lattice site)"));
+    }
+    Ok(st)
+}
+
+fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
+    let ph = &m.phases[pi];
+    let l = m.to_local(x);
+    let id = st.pos.len() as u32;
+    st.pos.push([l[0] as f32, l[1] as f32, l[2] as f32, 0.0]);
+    let v = if ph.is_fluid() {
+        [0.0; 4]
+    } else {
+        [
+            ph.velocity[0] as f32,
+            ph.velocity[1] as f32,
+            ph.velocity[2] as f32,
+            0.0,
+        ]
+    };
+    st.vel.push(v);
+    st.acc.push([0.0; 4]);
+    st.acc_b.push([0.0; 4]);
+    st.rho.push(ph.rho0 as f32);
+    st.p.push(0.0);
+    st.mass.push(ph.mass as f32);
+    st.phase.push(pi as u32);
+    st.id.push(id);
+}

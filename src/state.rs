@@ -1,0 +1,102 @@
+//! Particle state, structure of arrays, in the exact layout both backends use.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-step scalars that live on the device (DESIGN rule 7) and are read back only
+/// at output intervals.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable, Default)]
+pub struct Sim {
+    pub dt: f32,
+    pub time: f32,
+    pub step: u32,
+    /// Which F22 (42) limit bound the last step: see `DT_LIMIT_NAMES`.
+    pub dt_limit: u32,
+    pub umax2: f32,
+    pub amax2: f32,
+    pub _pad: [u32; 2],
+}
+
+pub const DT_LIMIT_NAMES: [&str; 4] = ["acoustic", "viscous", "force", "fixed"];
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct State {
+    /// Position relative to the grid origin (xyz, w unused).
+    pub pos: Vec<[f32; 4]>,
+    /// Velocity of fluids; for walls, the velocity the wall pass extrapolated.
+    pub vel: Vec<[f32; 4]>,
+    /// Acceleration from F22 (22)/(23) plus body force.
+    pub acc: Vec<[f32; 4]>,
+    /// Transport-velocity (background pressure) acceleration.
+    pub acc_b: Vec<[f32; 4]>,
+    pub rho: Vec<f32>,
+    pub p: Vec<f32>,
+    pub mass: Vec<f32>,
+    pub phase: Vec<u32>,
+    pub id: Vec<u32>,
+    pub sim: Sim,
+}
+
+/// A field viewed as raw 32-bit words, for bit-exact comparison.
+pub struct FieldView<'a> {
+    pub name: &'static str,
+    pub components: usize,
+    pub words: &'a [u32],
+    pub is_float: bool,
+}
+
+impl State {
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+    pub fn fields(&self) -> Vec<FieldView<'_>> {
+        vec![
+            vec4_field("position", &self.pos),
+            vec4_field("velocity", &self.vel),
+            vec4_field("acceleration", &self.acc),
+            vec4_field("transport_acceleration", &self.acc_b),
+            scalar_field("density", &self.rho),
+            scalar_field("pressure", &self.p),
+            scalar_field("mass", &self.mass),
+            FieldView {
+                name: "phase",
+                components: 1,
+                words: &self.phase,
+                is_float: false,
+            },
+            FieldView {
+                name: "id",
+                components: 1,
+                words: &self.id,
+                is_float: false,
+            },
+        ]
+    }
+}
+
+fn vec4_field<'a>(name: &'static str, v: &'a [[f32; 4]]) -> FieldView<'a> {
+    FieldView {
+        name,
+        components: 4,
+        words: bytemuck::cast_slice(v),
+        is_float: true,
+    }
+}
+
+fn scalar_field<'a>(name: &'static str, v: &'a [f32]) -> FieldView<'a> {
+    FieldView {
+        name,
+        components: 1,
+        words: bytemuck::cast_slice(v),
+        is_float: true,
+    }
+}
+
+/// Bytes the device and host hold per particle: the state above, the reorder scratch
+/// (5 vec4) and padded sort keys (2 × 8 bytes).
+pub const BYTES_PER_PARTICLE: u64 = 4 * 16 + 5 * 4 + 5 * 16 + 16;
+/// Bytes per grid cell: start and end tables.
+pub const BYTES_PER_CELL: u64 = 8;

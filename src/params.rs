@@ -59,7 +59,8 @@ pub fn kernel_sigma(kind: KernelKind, dim: u32, h: f64) -> f64 {
     let hd = h.powi(dim as i32);
     let s = match (kind, dim) {
         (KernelKind::Quintic, 2) => 7.0 / (478.0 * PI),
-        (KernelKind::Quintic, _) => 3.0 / (359.0 * PI),
+        // ∫(a−q)⁵q²dq = a⁸/168 ⇒ 4π/168·(3⁸ − 6·2⁸ + 15) = 120π.
+        (KernelKind::Quintic, _) => 1.0 / (120.0 * PI),
         (KernelKind::WendlandC2, 2) => 7.0 / (4.0 * PI),
         (KernelKind::WendlandC2, _) => 21.0 / (16.0 * PI),
         (KernelKind::Cubic, 2) => 10.0 / (7.0 * PI),

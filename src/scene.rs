@@ -267,7 +267,7 @@ fn describe(e: &toml::de::Error, text: &str) -> String {
     let msg = e.message().trim().to_string();
     match e.span() {
         Some(span) => {
-            let line = text[..span.start.min(text.len())].lines().count().max(1);
+            let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
             format!("{msg} (line {line})")
         }
         None => msg,
@@ -286,7 +286,7 @@ fn error_key_from_text(e: &toml::de::Error, text: &str) -> String {
             section = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
         }
     }
-    let line = upto.lines().last().unwrap_or("");
+    let line = upto.rsplit('\n').next().unwrap_or("");
     let rest = &text[span.start.min(text.len())..];
     let full_line = format!("{line}{}", rest.lines().next().unwrap_or(""));
     let key = full_line

@@ -1,0 +1,73 @@
+//! Bit-match contract (DESIGN.md): on the software adapter (lavapipe) the GPU passes
+//! give the same bits as their CPU twins, every field after every pass of 200 steps.
+
+mod common;
+use spatter::backend::cpu::CpuBackend;
+use spatter::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
+use spatter::compare::compare;
+use spatter::params::Params;
+use spatter::run::load;
+
+fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let l = load(&common::scene(name), &sets).unwrap();
+    let params = Params::new(&l.model, l.state.len() as u32);
+    std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
+        .expect("a Vulkan adapter (the test command installs lavapipe)");
+    assert!(
+        ctx.is_software(),
+        "bit-match needs the software adapter; hardware is compared by tolerance"
+    );
+    let mut gpu = GpuBackend::new(ctx, params, &l.state, false).unwrap();
+    let mut cpu = CpuBackend::new(params, l.state.clone());
+    let report = compare(&mut cpu, &mut gpu, steps, true);
+    if let Some(d) = report.first_difference {
+        panic!(
+            "{name} {sets:?}: step {} pass {} field {} particle {}: cpu {} gpu {}",
+            d.step, d.pass, d.field, d.particle, d.cpu, d.gpu
+        );
+    }
+    assert_eq!(report.stages_compared, 5 + 7 * steps);
+}
+
+#[test]
+fn dam_break_2d_200_steps() {
+    assert_bit_identical("dam_break_2d", &[], 200);
+}
+
+#[test]
+fn poiseuille_2d_periodic_200_steps() {
+    assert_bit_identical("poiseuille_2d", &[], 200);
+}
+
+#[test]
+fn two_layer_2d_200_steps() {
+    assert_bit_identical("two_layer_2d", &[], 200);
+}
+
+#[test]
+fn couette_2d_moving_wall_200_steps() {
+    assert_bit_identical("couette_2d", &[], 200);
+}
+
+/// The other two kernels, in 2D and 3D.
+#[test]
+fn wendland_and_cubic_kernels_50_steps() {
+    assert_bit_identical("poiseuille_2d", &["kernel=\"wendland_c2\""], 50);
+    assert_bit_identical("dam_break_2d", &["kernel=\"cubic\"", "dx=0.005"], 50);
+    assert_bit_identical("dam_break_3d", &["kernel=\"wendland_c2\"", "dx=0.02"], 50);
+    assert_bit_identical("dam_break_3d", &["kernel=\"cubic\"", "dx=0.02"], 50);
+}
+
+/// The command issue 2 names, exactly as a user runs it.
+#[test]
+fn compare_cli_dam_break_3d_200_steps() {
+    let out = common::spatter(&["compare", &common::scene("dam_break_3d"), "--steps", "200"]);
+    let (stdout, stderr) = common::text(&out);
+    assert!(
+        stdout.trim_end().ends_with("bit-identical: yes"),
+        "{stdout}{stderr}"
+    );
+    assert_eq!(out.status.code(), Some(0));
+}

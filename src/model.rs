@@ -472,36 +472,38 @@ fn check_walls(
         }
         _ => {}
     }
-    const SIDES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"];
     for side in &scene.domain.open_sides {
-        let key = "domain.open_sides";
-        let Some(i) = SIDES.iter().position(|s| s == side) else {
-            return Err(cx.err(
-                key,
-                format!("unknown side `{side}` (use x_min, x_max, y_min, y_max, z_min, z_max)"),
-            ));
-        };
-        if i / 2 >= dim as usize || periodic[i / 2] {
-            return Err(cx.err(
-                key,
-                format!("side `{side}` has no wall to open (axis absent or periodic)"),
-            ));
-        }
+        check_side(cx, "domain.open_sides", side, dim, periodic)?;
     }
     for (side, w) in &scene.domain.wall_sides {
         let key = format!("domain.wall_sides.{side}");
-        let Some(i) = SIDES.iter().position(|s| s == side) else {
-            return Err(cx.err(
-                &key,
-                "unknown side (use x_min, x_max, y_min, y_max, z_min, z_max)",
-            ));
-        };
-        if i / 2 >= dim as usize || periodic[i / 2] {
-            return Err(cx.err(&key, "this side has no wall (axis absent or periodic)"));
-        }
+        check_side(cx, &key, side, dim, periodic)?;
         if !is_wall(w) {
             return Err(cx.err(&key, format!("`{w}` is not a phase of kind \"wall\"")));
         }
+    }
+    Ok(())
+}
+
+/// A side named in the domain must exist and have walls (not absent, not periodic).
+fn check_side(
+    cx: &Ctx,
+    key: &str,
+    side: &str,
+    dim: u32,
+    periodic: [bool; 3],
+) -> Result<(), InputError> {
+    let Some(axis) = crate::scene::side_axis(side) else {
+        return Err(cx.err(
+            key,
+            format!("unknown side `{side}` (use x_min, x_max, y_min, y_max, z_min, z_max)"),
+        ));
+    };
+    if axis >= dim as usize || periodic[axis] {
+        return Err(cx.err(
+            key,
+            format!("side `{side}` has no wall (axis absent or periodic)"),
+        ));
     }
     Ok(())
 }

@@ -139,6 +139,14 @@ pub struct Domain {
     pub open_sides: Vec<String>,
 }
 
+/// Names of the domain sides, by axis then (min, max).
+pub const SIDE_NAMES: [[&str; 2]; 3] = [["x_min", "x_max"], ["y_min", "y_max"], ["z_min", "z_max"]];
+
+/// Axis of a side name (`x_min` → 0), None if the name is not a side.
+pub fn side_axis(name: &str) -> Option<usize> {
+    SIDE_NAMES.iter().position(|pair| pair.contains(&name))
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {

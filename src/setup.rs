@@ -191,7 +191,7 @@ impl SplitMix {
 }
 
 fn wall_phase_at(m: &Model, scene: &SceneFile, x: [f64; 3]) -> Option<usize> {
-    const SIDES: [[&str; 2]; 3] = [["x_min", "x_max"], ["y_min", "y_max"], ["z_min", "z_max"]];
+    use crate::scene::SIDE_NAMES as SIDES;
     for a in 0..m.dim as usize {
         let side = if x[a] < m.domain_lo[a] {
             0

@@ -2,7 +2,7 @@
 //! contract). On a software adapter any difference is a failure; on hardware the
 //! largest relative difference per field after one step is reported instead.
 
-use crate::backend::{Backend, Stage, PRIME, STEP};
+use crate::backend::{Backend, Stage};
 use crate::state::State;
 
 #[derive(Debug, Clone)]
@@ -122,7 +122,13 @@ pub fn compare(
         }
         true
     };
-    for s in PRIME {
+    assert_eq!(
+        cpu.pipeline(),
+        gpu.pipeline(),
+        "both backends run the same stages"
+    );
+    let pipeline = cpu.pipeline().clone();
+    for &s in &pipeline.prime {
         if !check(cpu, gpu, 0, s, &mut report) {
             return report;
         }
@@ -135,7 +141,7 @@ pub fn compare(
         return report;
     }
     for step in 1..=steps {
-        for s in STEP {
+        for &s in &pipeline.step {
             if !check(cpu, gpu, step, s, &mut report) {
                 return report;
             }

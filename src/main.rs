@@ -1,7 +1,7 @@
 use clap::{Parser, Subcommand};
 use spatter::backend::cpu::CpuBackend;
 use spatter::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
-use spatter::backend::WCSPH_PASSES;
+use spatter::backend::Pipeline;
 use spatter::error::SpatterError;
 use spatter::model::EndCondition;
 use spatter::params::Params;
@@ -215,7 +215,11 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),
         None => println!("time step: adaptive, initially {lim:.4e} s"),
     }
-    println!("passes: {}", WCSPH_PASSES.join(", "));
+    let params = Params::new(m, st.len() as u32);
+    println!(
+        "passes: {}",
+        Pipeline::for_scene(&params, st).pass_names().join(", ")
+    );
     Ok(ExitCode::SUCCESS)
 }
 

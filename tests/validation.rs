@@ -113,6 +113,24 @@ fn validate_lists_only_fluid_passes() {
 }
 
 #[test]
+fn scene_without_walls_has_no_wall_pass() {
+    let out = common::spatter(&[
+        "validate",
+        &common::scene("poiseuille_2d"),
+        "--set",
+        "domain.periodic=[true,true]",
+    ]);
+    let (stdout, stderr) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l == "passes: neighbors, density, forces, integrate, timestep"),
+        "{stdout}"
+    );
+}
+
+#[test]
 fn set_override_changes_resolution() {
     let coarse = load(&common::scene("dam_break_2d"), &["dx=0.005".into()]).unwrap();
     let fine = load(&common::scene("dam_break_2d"), &[]).unwrap();

@@ -4,6 +4,7 @@
 pub mod cpu;
 pub mod gpu;
 
+use crate::params::Params;
 use crate::state::{Sim, State};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,9 +37,16 @@ impl Stage {
             Stage::Timestep => "timestep",
         }
     }
+    /// The compute pass (WGSL file) a stage belongs to.
+    pub fn pass(self) -> &'static str {
+        match self {
+            Stage::KickDrift | Stage::Kick => "integrate",
+            other => other.name(),
+        }
+    }
 }
 
-/// One velocity-Verlet (kick–drift–kick) step.
+/// One velocity-Verlet (kick–drift–kick) step with every stage a WCSPH scene can need.
 pub const STEP: [Stage; 7] = [
     Stage::KickDrift,
     Stage::Neighbors,
@@ -58,8 +66,8 @@ pub const PRIME: [Stage; 5] = [
     Stage::Timestep,
 ];
 
-/// The compute passes of a WCSPH scene, as `spatter validate` lists them.
-pub const WCSPH_PASSES: [&str; 6] = [
+/// The compute passes in the order `spatter validate` lists them.
+const PASS_ORDER: [&str; 6] = [
     "neighbors",
     "density",
     "wall",
@@ -68,22 +76,52 @@ pub const WCSPH_PASSES: [&str; 6] = [
     "timestep",
 ];
 
+/// The stages a scene runs: only what its physics needs (DESIGN.md). A scene
+/// without wall particles has no wall pass.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Pipeline {
+    pub step: Vec<Stage>,
+    pub prime: Vec<Stage>,
+}
+
+impl Pipeline {
+    pub fn for_scene(params: &Params, st: &State) -> Pipeline {
+        let walls = st.phase.iter().any(|&p| params.is_wall(p));
+        let needed = |s: &&Stage| walls || **s != Stage::Wall;
+        Pipeline {
+            step: STEP.iter().filter(needed).copied().collect(),
+            prime: PRIME.iter().filter(needed).copied().collect(),
+        }
+    }
+    /// Pass names, each once, for `spatter validate`.
+    pub fn pass_names(&self) -> Vec<&'static str> {
+        PASS_ORDER
+            .iter()
+            .copied()
+            .filter(|n| self.step.iter().any(|s| s.pass() == *n))
+            .collect()
+    }
+}
+
 pub trait Backend {
     /// "cpu (2 threads)" or "gpu: <adapter> (<driver>)".
     fn describe(&self) -> String;
     /// True for a software rasteriser (lavapipe): bit-identical results are expected.
     fn is_software(&self) -> bool;
+    /// The stages this scene runs.
+    fn pipeline(&self) -> &Pipeline;
     fn run_stage(&mut self, stage: Stage);
     /// Run `n` whole steps without reading anything back.
     fn run_steps(&mut self, n: u32) {
+        let step = self.pipeline().step.clone();
         for _ in 0..n {
-            for s in STEP {
+            for &s in &step {
                 self.run_stage(s);
             }
         }
     }
     fn prime(&mut self) {
-        for s in PRIME {
+        for s in self.pipeline().prime.clone() {
             self.run_stage(s);
         }
     }

@@ -9,7 +9,7 @@ mod neighbors;
 mod timestep;
 mod wall;
 
-use super::{Backend, Stage};
+use super::{Backend, Pipeline, Stage};
 use crate::params::Params;
 use crate::state::{Sim, State};
 use std::time::Instant;
@@ -17,14 +17,17 @@ use std::time::Instant;
 pub struct CpuBackend {
     pub params: Params,
     pub st: State,
+    pipeline: Pipeline,
     grid: neighbors::CellTable,
     times: Vec<(&'static str, f64)>,
 }
 
 impl CpuBackend {
     pub fn new(params: Params, st: State) -> Self {
+        let pipeline = Pipeline::for_scene(&params, &st);
         CpuBackend {
             params,
+            pipeline,
             st,
             grid: neighbors::CellTable::default(),
             times: Vec::new(),
@@ -56,6 +59,9 @@ impl Backend for CpuBackend {
     }
     fn is_software(&self) -> bool {
         true
+    }
+    fn pipeline(&self) -> &Pipeline {
+        &self.pipeline
     }
     fn run_stage(&mut self, stage: Stage) {
         let t0 = Instant::now();

@@ -7,7 +7,7 @@ pub mod probe;
 
 pub use context::{AdapterChoice, GpuContext};
 
-use super::{Backend, Stage, STEP};
+use super::{Backend, Pipeline, Stage};
 use crate::params::Params;
 use crate::state::{Sim, State};
 use std::collections::HashMap;
@@ -66,6 +66,7 @@ struct Buffers {
 pub struct GpuBackend {
     ctx: GpuContext,
     params: Params,
+    pipeline: Pipeline,
     n: u32,
     n_pad: u32,
     n_sort_stages: u32,
@@ -107,6 +108,7 @@ impl GpuBackend {
                 "scene needs a {biggest}-byte GPU buffer but the adapter allows {limit} bytes per binding; use the cpu backend or a larger dx"
             ));
         }
+        let pipeline = Pipeline::for_scene(&params, st);
         let v4 = n as u64 * 16;
         let s1 = n as u64 * 4;
         let stages = sort_stages(n_pad);
@@ -172,13 +174,18 @@ impl GpuBackend {
                 .features()
                 .contains(wgpu::Features::TIMESTAMP_QUERY)
         {
-            Some(Profiler::new(device, ctx.queue.get_timestamp_period()))
+            Some(Profiler::new(
+                device,
+                ctx.queue.get_timestamp_period(),
+                pipeline.step.len(),
+            ))
         } else {
             None
         };
         let mut g = GpuBackend {
             ctx,
             params,
+            pipeline,
             n,
             n_pad,
             n_sort_stages: stages.len() as u32,
@@ -331,13 +338,14 @@ impl GpuBackend {
     fn collect_profile(&mut self) {
         let Some(p) = &self.profiler else { return };
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        enc.resolve_query_set(&p.queries, 0..2 * STEP.len() as u32, &p.resolve, 0);
+        let stages = self.pipeline.step.len();
+        enc.resolve_query_set(&p.queries, 0..2 * stages as u32, &p.resolve, 0);
         self.submit(enc);
         let ticks: Vec<u64> =
-            bytemuck::cast_slice(&self.read_bytes(&p.resolve, 16 * STEP.len() as u64)).to_vec();
+            bytemuck::cast_slice(&self.read_bytes(&p.resolve, 16 * stages as u64)).to_vec();
         let period = p.period_ns as f64;
         let p = self.profiler.as_mut().unwrap();
-        for (k, s) in STEP.iter().enumerate() {
+        for (k, s) in self.pipeline.step.iter().enumerate() {
             let ms = ticks[2 * k + 1].saturating_sub(ticks[2 * k]) as f64 * period * 1e-6;
             match p.totals.iter_mut().find(|(n, _)| *n == s.name()) {
                 Some(e) => e.1 += ms,
@@ -348,8 +356,8 @@ impl GpuBackend {
 }
 
 impl Profiler {
-    fn new(device: &wgpu::Device, period_ns: f32) -> Self {
-        let count = 2 * STEP.len() as u32;
+    fn new(device: &wgpu::Device, period_ns: f32, stages: usize) -> Self {
+        let count = 2 * stages as u32;
         Profiler {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass timestamps"),
@@ -529,9 +537,17 @@ impl Backend for GpuBackend {
     fn is_software(&self) -> bool {
         self.ctx.is_software()
     }
+    fn pipeline(&self) -> &Pipeline {
+        &self.pipeline
+    }
     fn run_stage(&mut self, stage: Stage) {
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        let idx = STEP.iter().position(|s| *s == stage).unwrap_or(0) as u32;
+        let idx = self
+            .pipeline
+            .step
+            .iter()
+            .position(|s| *s == stage)
+            .unwrap_or(0) as u32;
         self.encode_stage(&mut enc, stage, idx);
         self.submit(enc);
     }
@@ -540,7 +556,7 @@ impl Backend for GpuBackend {
             // One step per submission so each pass's timestamps can be collected.
             for _ in 0..n {
                 let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-                for (k, s) in STEP.iter().enumerate() {
+                for (k, s) in self.pipeline.step.iter().enumerate() {
                     self.encode_stage(&mut enc, *s, k as u32);
                 }
                 self.submit(enc);
@@ -554,7 +570,7 @@ impl Backend for GpuBackend {
             let chunk = left.min(32);
             let mut enc = self.ctx.device.create_command_encoder(&Default::default());
             for _ in 0..chunk {
-                for (k, s) in STEP.iter().enumerate() {
+                for (k, s) in self.pipeline.step.iter().enumerate() {
                     self.encode_stage(&mut enc, *s, k as u32);
                 }
             }

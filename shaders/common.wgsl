@@ -14,7 +14,7 @@ struct Params {
     dtp: vec4<f32>,          // h, c_max, viscous limit, fixed dt
     phase_a: array<vec4<f32>, 8>, // rho0, c², eta, kind
     phase_b: array<vec4<f32>, 8>, // wall velocity, slip
-    consts: array<vec4<f32>, 4>,  // arithmetic literals, see c_* below
+    consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
 }
 
 struct Sim {

@@ -9,6 +9,7 @@ pub mod error;
 pub mod kernel;
 pub mod model;
 pub mod params;
+pub mod portable_math;
 pub mod run;
 pub mod scene;
 pub mod setup;

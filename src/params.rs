@@ -43,16 +43,24 @@ pub struct Params {
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
     /// shaders read every multiplying or adding literal from here.
-    pub consts: [[f32; 4]; 4],
+    pub consts: [[f32; 4]; 8],
 }
 
-/// Mirrors the `c_*` functions in shaders/common.wgsl.
-pub const SHADER_CONSTS: [[f32; 4]; 4] = [
-    [0.5, 0.25, 2.0, 1.0],
-    [3.0, 6.0, 15.0, 5.0],
-    [30.0, 75.0, 1.5, 0.75],
-    [2.25, 0.0, 0.0, 0.0],
-];
+/// Mirrors the `c_*` and portable-math constants in shaders/common.wgsl and
+/// shaders/portable_math.wgsl; src/portable_math.rs uses the same f32 values.
+pub const SHADER_CONSTS: [[f32; 4]; 8] = {
+    use crate::portable_math as pm;
+    [
+        [0.5, 0.25, 2.0, 1.0],
+        [3.0, 6.0, 15.0, 5.0],
+        [30.0, 75.0, 1.5, 0.75],
+        [2.25, pm::LOG2E, pm::LN2_HI, pm::LN2_LO],
+        [pm::EXP_C[0], pm::EXP_C[1], pm::EXP_C[2], pm::EXP_C[3]],
+        [pm::EXP_C[4], pm::EXP_C[5], pm::LN_C[0], pm::LN_C[1]],
+        [pm::LN_C[2], pm::LN_C[3], pm::LN_C[4], 0.0],
+        [0.0; 4],
+    ]
+};
 
 /// Kernel normalisation σ so that ∫W = 1 (Morris 1997 quintic, Wendland C2, cubic spline).
 pub fn kernel_sigma(kind: KernelKind, dim: u32, h: f64) -> f64 {

@@ -27,6 +27,8 @@ const SHADERS: [(&str, &str); 6] = [
     ("timestep", include_str!("../../../shaders/timestep.wgsl")),
 ];
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
+/// Portable exp/ln/pow, prepended to every pass (twin of src/portable_math.rs).
+const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
 const ENTRY_POINTS: [(&str, &str, &str); 11] = [
@@ -495,7 +497,7 @@ fn build_pipelines(
     let modules: HashMap<&str, wgpu::ShaderModule> = SHADERS
         .iter()
         .map(|(name, src)| {
-            let source = format!("{COMMON}\n{src}");
+            let source = format!("{COMMON}\n{PORTABLE_MATH}\n{src}");
             let m = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(name),
                 source: wgpu::ShaderSource::Wgsl(source.into()),

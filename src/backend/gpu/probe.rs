@@ -1,12 +1,14 @@
-//! Evaluate a WGSL expression of `a`, `b`, `c` element-wise on the device. Used by the
-//! tests that pin down the adapter's float arithmetic (fusion, portable math).
+//! Evaluate a WGSL expression of `a`, `b`, `c` element-wise on the device, with the
+//! shared shader code (common.wgsl, portable_math.wgsl) and a parameter block bound
+//! as in the real passes. Used by the tests that pin down the adapter's arithmetic.
 
-use super::GpuContext;
+use super::{GpuContext, COMMON, PORTABLE_MATH};
+use crate::params::Params;
 use wgpu::util::DeviceExt;
 
 pub fn eval_f32(
     ctx: &GpuContext,
-    prelude: &str,
+    params: &Params,
     expr: &str,
     a: &[f32],
     b: &[f32],
@@ -14,11 +16,12 @@ pub fn eval_f32(
 ) -> Vec<f32> {
     let n = a.len();
     let src = format!(
-        "{prelude}
-@group(0) @binding(0) var<storage, read_write> va: array<f32>;
-@group(0) @binding(1) var<storage, read_write> vb: array<f32>;
-@group(0) @binding(2) var<storage, read_write> vc: array<f32>;
-@group(0) @binding(3) var<storage, read_write> out: array<f32>;
+        "{COMMON}
+{PORTABLE_MATH}
+@group(1) @binding(0) var<storage, read_write> va: array<f32>;
+@group(1) @binding(1) var<storage, read_write> vb: array<f32>;
+@group(1) @binding(2) var<storage, read_write> vc: array<f32>;
+@group(1) @binding(3) var<storage, read_write> out: array<f32>;
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
     let i = gid.x;
@@ -51,7 +54,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         })
     };
     let bufs = [mk(a), mk(b), mk(c), mk(&vec![0.0f32; n])];
-    let layout = pipeline.get_bind_group_layout(0);
+    let layout = pipeline.get_bind_group_layout(1);
     let entries: Vec<wgpu::BindGroupEntry> = bufs
         .iter()
         .enumerate()
@@ -65,6 +68,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         layout: &layout,
         entries: &entries,
     });
+    let pbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("params"),
+        contents: bytemuck::bytes_of(params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let pbg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: pbuf.as_entire_binding(),
+        }],
+    });
     let staging = d.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: (n * 4) as u64,
@@ -75,7 +91,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
+        pass.set_bind_group(0, &pbg, &[]);
+        pass.set_bind_group(1, &bg, &[]);
         pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
     }
     enc.copy_buffer_to_buffer(&bufs[3], 0, &staging, 0, (n * 4) as u64);

@@ -1,0 +1,55 @@
+// Portable exp, ln and pow. Twin of src/portable_math.rs (same operations, same
+// order); coefficients come from the parameter block so the compiler cannot
+// reassociate them (see common.wgsl).
+
+fn pm_exp(x: f32) -> f32 {
+    if (x != x) { return x; }
+    if (x > 88.0) { return bitcast<f32>(0x7f800000u); }
+    if (x < -87.3) { return 0.0; }
+    let log2e = P.consts[3].y;
+    let ln2_hi = P.consts[3].z;
+    let ln2_lo = P.consts[3].w;
+    let c0 = P.consts[4].x;
+    let c1 = P.consts[4].y;
+    let c2 = P.consts[4].z;
+    let c3 = P.consts[4].w;
+    let c4 = P.consts[5].x;
+    let c5 = P.consts[5].y;
+    let one = c_one();
+    let n = floor(x * log2e + c0);
+    let r = (x - n * ln2_hi) - n * ln2_lo;
+    let p = one + r * (one + r * (c0 + r * (c1 + r * (c2 + r * (c3 + r * (c4 + r * c5))))));
+    let scale = bitcast<f32>(u32(i32(n) + 127) << 23u);
+    return p * scale;
+}
+
+fn pm_ln(x: f32) -> f32 {
+    if (!(x > 0.0)) {
+        if (x == 0.0) { return bitcast<f32>(0xff800000u); }
+        return bitcast<f32>(0x7fc00000u);
+    }
+    if (x == bitcast<f32>(0x7f800000u)) { return x; }
+    let bits = bitcast<u32>(x);
+    var e = i32((bits >> 23u) & 0xffu) - 127;
+    var m = bitcast<f32>((bits & 0x007fffffu) | 0x3f800000u);
+    if (m > 1.41421354) {
+        m = m * c_half();
+        e = e + 1;
+    }
+    let f = m - c_one();
+    let s = f / (c_two() + f);
+    let z = s * s;
+    let l0 = P.consts[5].z;
+    let l1 = P.consts[5].w;
+    let l2 = P.consts[6].x;
+    let l3 = P.consts[6].y;
+    let l4 = P.consts[6].z;
+    let poly = c_one() + z * (l0 + z * (l1 + z * (l2 + z * (l3 + z * l4))));
+    let lnm = (s + s) * poly;
+    let ef = f32(e);
+    return ef * P.consts[3].z + (ef * P.consts[3].w + lnm);
+}
+
+fn pm_pow(x: f32, y: f32) -> f32 {
+    return pm_exp(y * pm_ln(x));
+}

@@ -144,3 +144,33 @@ fn set_override_changes_resolution() {
     };
     assert_eq!(fluid(&coarse) * 4, fluid(&fine));
 }
+
+/// The GPU path runs a whole scene to the same verdict, and `--profile` reports
+/// per-pass milliseconds from timestamp queries.
+#[test]
+fn gpu_run_with_profile_reports_passes() {
+    let out = common::spatter(&[
+        "run",
+        &common::scene("poiseuille_2d"),
+        "--backend",
+        "gpu",
+        "--profile",
+    ]);
+    let (stdout, stderr) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    assert!(stdout.contains("backend: gpu: "), "{stdout}");
+    for pass in ["neighbors", "density", "wall", "forces", "timestep"] {
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.starts_with(&format!("pass {pass}: ")) && l.ends_with("ms/step")),
+            "{pass}: {stdout}"
+        );
+    }
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("check poiseuille:") && l.ends_with("PASS")),
+        "{stdout}"
+    );
+}

@@ -41,6 +41,11 @@ fn hydrostatic_pressure_within_2_percent() {
 }
 
 #[test]
+fn hydrostatic_3d_pressure_within_2_percent() {
+    check_passes("hydrostatic_3d");
+}
+
+#[test]
 fn two_layer_no_crossing_and_continuous_pressure() {
     check_passes("two_layer_2d");
 }

@@ -3,14 +3,18 @@
 
 pub mod backend;
 pub mod bench;
+pub mod checkpoint;
 pub mod checks;
 pub mod compare;
 pub mod error;
 pub mod kernel;
+pub mod inspect;
 pub mod model;
+pub mod output;
 pub mod params;
 pub mod portable_math;
 pub mod run;
 pub mod scene;
 pub mod setup;
 pub mod state;
+pub mod watchdog;

@@ -5,7 +5,11 @@ use spatter::backend::Pipeline;
 use spatter::error::SpatterError;
 use spatter::model::EndCondition;
 use spatter::params::Params;
-use spatter::run::{self, BackendChoice, RunOptions};
+use spatter::checkpoint::CheckpointSink;
+use spatter::error::InputError;
+use spatter::output::mcap_out::{McapSink, Provenance};
+use spatter::output::vtk::VtkSink;
+use spatter::run::{self, BackendChoice, Outputs, RunEnd, RunOptions};
 use spatter::{bench, compare, setup};
 use std::process::ExitCode;
 
@@ -22,9 +26,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a scenario.
+    /// Run a scenario (or continue one from a checkpoint with --resume).
     Run {
-        scenario: String,
+        /// Scenario TOML; omit it with --resume (the checkpoint carries its scenario).
+        #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+        scenario: Option<String>,
         #[arg(long, value_enum, default_value = "auto")]
         backend: BackendChoice,
         /// Simulated end time in seconds (overrides the scenario).
@@ -39,7 +45,11 @@ enum Command {
         /// Per-pass GPU timestamps (or CPU pass timers), printed at the end.
         #[arg(long)]
         profile: bool,
+        #[command(flatten)]
+        outputs: OutputArgs,
     },
+    /// Summarise an MCAP run file: channels, schemas, counts, time span, scenario.
+    Inspect { file: String },
     /// Parse and check a scenario; print particles, memory, time-step limits and passes.
     Validate {
         scenario: String,
@@ -59,6 +69,25 @@ enum Command {
         #[command(subcommand)]
         which: BenchKind,
     },
+}
+
+#[derive(clap::Args)]
+struct OutputArgs {
+    /// Write an MCAP stream (/particles as foxglove.PointCloud, /diagnostics as JSON).
+    #[arg(long, value_name = "FILE")]
+    out: Option<String>,
+    /// Write a VTK series (.vtu per frame and particles.pvd) into this folder.
+    #[arg(long, value_name = "DIR")]
+    vtk: Option<String>,
+    /// Write a checkpoint every T seconds of simulated time (and at the end).
+    #[arg(long, value_name = "T")]
+    checkpoint_every: Option<f64>,
+    /// Folder for checkpoints (default: beside --out, else inside --vtk).
+    #[arg(long, value_name = "DIR")]
+    checkpoint_dir: Option<String>,
+    /// Continue from a checkpoint file; bit-identical to an uninterrupted run.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -90,7 +119,17 @@ fn main() -> ExitCode {
             steps,
             sets,
             profile,
-        } => cmd_run(&scenario, backend, until, steps, &sets, profile),
+            outputs,
+        } => cmd_run(
+            scenario.as_deref(),
+            backend,
+            until,
+            steps,
+            &sets,
+            profile,
+            &outputs,
+        ),
+        Command::Inspect { file } => cmd_inspect(&file),
         Command::Validate { scenario, sets } => cmd_validate(&scenario, &sets),
         Command::Compare {
             scenario,
@@ -115,38 +154,66 @@ fn main() -> ExitCode {
         }
         Err(SpatterError::Runtime(m)) => {
             eprintln!("error: {m}");
-            ExitCode::from(if m.starts_with("unstable") { 3 } else { 1 })
+            ExitCode::from(1)
         }
     }
 }
 
+/// Exit code of a run stopped by SIGINT/SIGTERM (shell convention 128 + SIGINT).
+const EXIT_INTERRUPTED: u8 = 130;
+/// Exit code of a run the watchdog stopped.
+const EXIT_UNSTABLE: u8 = 3;
+
 fn cmd_run(
-    path: &str,
+    path: Option<&str>,
     choice: BackendChoice,
     until: Option<f64>,
     steps: Option<u64>,
     sets: &[String],
     profile: bool,
+    out_args: &OutputArgs,
 ) -> Result<ExitCode, SpatterError> {
-    let loaded = run::load(path, sets)?;
+    let (loaded, resumed_from) = match (&out_args.resume, path) {
+        (Some(ckpt), _) => (run::load_checkpoint(ckpt, sets)?, Some(ckpt.as_str())),
+        (None, Some(p)) => (run::load(p, sets)?, None),
+        (None, None) => unreachable!("clap requires a scenario or --resume"),
+    };
+    let label = path.or(resumed_from).unwrap_or_default();
     let end = match (until, steps) {
         (Some(t), _) if t > 0.0 => EndCondition::Time(t),
         (Some(t), _) => {
-            return Err(spatter::error::InputError::new(
-                path,
-                "--until",
-                format!("must be positive (got {t})"),
-            )
-            .into())
+            return Err(InputError::new(label, "--until", format!("must be positive (got {t})")).into())
         }
         (None, Some(n)) => EndCondition::Steps(n),
-        (None, None) => loaded.model.end,
+        // A scene's step count is a total: a resumed run continues up to it.
+        (None, None) => match loaded.model.end {
+            EndCondition::Steps(n) => {
+                EndCondition::Steps(n.saturating_sub(loaded.state.sim.step as u64))
+            }
+            e => e,
+        },
     };
+    if let Some(t) = out_args.checkpoint_every {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(InputError::new(label, "--checkpoint-every", format!("must be positive (got {t})")).into());
+        }
+    }
     let mut backend = run::make_backend(choice, &loaded, profile)?;
-    println!("scenario: {path}");
-    println!("backend: {}", backend.describe());
+    let backend_name = backend.describe();
+    let mut outputs = open_outputs(out_args, &loaded, &backend_name)?;
+    install_signal_handler();
+    match resumed_from {
+        Some(c) => println!("resumed: {c} (step {}, t = {:.6e} s)", loaded.state.sim.step, loaded.state.sim.time),
+        None => println!("scenario: {label}"),
+    }
+    println!("backend: {backend_name}");
     println!("particles: {}", loaded.state.len());
-    let report = run::run(&loaded, backend.as_mut(), &RunOptions { end, quiet: false })?;
+    let opts = RunOptions {
+        end,
+        quiet: false,
+        resumed: resumed_from.is_some(),
+    };
+    let report = run::run(&loaded, backend.as_mut(), &opts, &mut outputs)?;
     println!(
         "steps: {}, simulated time: {:.6e} s",
         report.steps, report.sim_time
@@ -158,7 +225,19 @@ fn cmd_run(
             println!("pass {name}: {:.4} ms/step", ms / steps);
         }
     }
+    print_outputs(&outputs, &report);
     let mut code = ExitCode::SUCCESS;
+    match &report.end {
+        RunEnd::Completed => {}
+        RunEnd::Interrupted => {
+            eprintln!("interrupted by a signal at step {}: outputs finished", report.final_state.sim.step);
+            code = ExitCode::from(EXIT_INTERRUPTED);
+        }
+        RunEnd::Unstable(trip) => {
+            eprintln!("error: {}", trip.message());
+            code = ExitCode::from(EXIT_UNSTABLE);
+        }
+    }
     if let Some(c) = &report.check {
         for d in &c.details {
             println!("{d}");
@@ -174,6 +253,74 @@ fn cmd_run(
         report.particle_steps_per_s()
     );
     Ok(code)
+}
+
+/// Open every requested output before the first step, so a bad path fails early
+/// (exit 2, nothing simulated).
+fn open_outputs(a: &OutputArgs, l: &run::Loaded, backend: &str) -> Result<Outputs, SpatterError> {
+    let io_err = |key: &str, m: String| SpatterError::Input(InputError::new(&l.model.file, key, m));
+    let command: Vec<String> = std::env::args().collect();
+    let mut o = Outputs::default();
+    o.backend = backend.to_string();
+    o.checkpoint_every = a.checkpoint_every;
+    if let Some(p) = &a.out {
+        let prov = Provenance {
+            backend,
+            command: &command.join(" "),
+        };
+        o.mcap = Some(McapSink::create(p, &l.model, &prov).map_err(|e| io_err("--out", e))?);
+    }
+    if let Some(d) = &a.vtk {
+        o.vtk = Some(VtkSink::create(d).map_err(|e| io_err("--vtk", e))?);
+    }
+    let ckpt_dir = a.checkpoint_dir.clone().or_else(|| {
+        a.out
+            .as_ref()
+            .map(|p| format!("{}.checkpoints", p.trim_end_matches(".mcap")))
+            .or_else(|| a.vtk.as_ref().map(|d| format!("{d}/checkpoints")))
+    });
+    match ckpt_dir {
+        Some(d) => {
+            o.checkpoints = Some(CheckpointSink::create(&d).map_err(|e| io_err("--checkpoint-dir", e))?)
+        }
+        None if a.checkpoint_every.is_some() => {
+            return Err(io_err(
+                "--checkpoint-every",
+                "needs a place to write: give --checkpoint-dir, --out or --vtk".into(),
+            ))
+        }
+        None => {}
+    }
+    Ok(o)
+}
+
+fn print_outputs(o: &Outputs, r: &run::RunReport) {
+    if let Some(m) = &o.mcap {
+        println!("mcap: {} frames", m.frames);
+    }
+    match &r.last_checkpoint {
+        Some(p) => println!("checkpoint: {}", p.display()),
+        None if matches!(r.end, RunEnd::Unstable(_) | RunEnd::Interrupted) => {
+            println!("checkpoint: none written (give --out, --vtk or --checkpoint-dir)")
+        }
+        None => {}
+    }
+}
+
+/// SIGINT/SIGTERM ask the step loop to stop and finish its files; a second signal
+/// exits at once (files stay readable up to their last complete chunk).
+fn install_signal_handler() {
+    let _ = ctrlc::set_handler(|| {
+        if run::STOP.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(EXIT_INTERRUPTED as i32);
+        }
+    });
+}
+
+fn cmd_inspect(path: &str) -> Result<ExitCode, SpatterError> {
+    let i = spatter::inspect::inspect(path)?;
+    print!("{}", i.text);
+    Ok(ExitCode::SUCCESS)
 }
 
 fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {

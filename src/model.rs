@@ -2,7 +2,7 @@
 //! sense, plus the host-side time-step limits (F22 (42)).
 
 use crate::error::InputError;
-use crate::scene::{CheckDef, Formulation, KernelKind, PhaseKind, SceneFile, Slip};
+use crate::scene::{CheckDef, Formulation, KernelKind, PhaseKind, SceneFile, Slip, WatchdogDef};
 
 #[derive(Debug, Clone)]
 pub struct PhaseInfo {
@@ -67,6 +67,8 @@ pub struct Model {
     /// Origin of the cell grid; particle positions are stored relative to it.
     pub origin: [f64; 3],
     pub periodic: [bool; 3],
+    /// Sides without wall layers, by axis then (min, max).
+    pub open_sides: [[bool; 2]; 3],
     pub grid: [u32; 3],
     pub cell_size: [f64; 3],
     pub wall_layers: u32,
@@ -79,7 +81,9 @@ pub struct Model {
     pub fixed_dt: Option<f64>,
     pub end: EndCondition,
     pub output_interval: f64,
+    pub diagnostics_interval: f64,
     pub check: Option<CheckDef>,
+    pub watchdog: WatchdogDef,
     pub limits: DtLimits,
 }
 
@@ -236,7 +240,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         Some(dt) => {
             cx.positive("run.dt", dt)?;
             let (lim, which) = limits.min();
-            if dt > lim {
+            if dt > lim && run.dt_check.unwrap_or(true) {
                 return Err(cx.err(
                     "run.dt",
                     format!(
@@ -261,8 +265,28 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             EndCondition::Steps(_) => f64::INFINITY,
         },
     };
+    let diagnostics_interval = match run.diagnostics_interval {
+        Some(v) => cx.positive("run.diagnostics_interval", v)?,
+        None => output_interval,
+    };
     if let Some(c) = &scene.check {
         cx.positive("check.tolerance", c.tolerance)?;
+    }
+    let wd = &scene.watchdog;
+    cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
+    cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
+    cx.positive("watchdog.wall_penetration", wd.wall_penetration)?;
+    if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
+        return Err(cx.err(
+            "watchdog.max_density_ratio",
+            format!("must be a finite number above 1 (got {})", wd.max_density_ratio),
+        ));
+    }
+    if wd.min_density_ratio >= 1.0 {
+        return Err(cx.err(
+            "watchdog.min_density_ratio",
+            format!("must be below 1 (got {})", wd.min_density_ratio),
+        ));
     }
 
     Ok(Model {
@@ -278,6 +302,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         domain_hi,
         origin,
         periodic,
+        open_sides: open_side_flags(scene),
         grid,
         cell_size,
         wall_layers,
@@ -290,7 +315,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         fixed_dt,
         end,
         output_interval,
+        diagnostics_interval,
         check: scene.check.clone(),
+        watchdog: scene.watchdog.clone(),
         limits,
     })
 }
@@ -483,6 +510,16 @@ fn check_walls(
         }
     }
     Ok(())
+}
+
+fn open_side_flags(scene: &SceneFile) -> [[bool; 2]; 3] {
+    let mut open = [[false; 2]; 3];
+    for (a, pair) in crate::scene::SIDE_NAMES.iter().enumerate() {
+        for (k, name) in pair.iter().enumerate() {
+            open[a][k] = scene.domain.open_sides.iter().any(|s| s == name);
+        }
+    }
+    open
 }
 
 /// A side named in the domain must exist and have walls (not absent, not periodic).

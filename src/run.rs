@@ -10,7 +10,12 @@ use crate::params::Params;
 use crate::scene;
 use crate::setup;
 use crate::state::{State, DT_LIMIT_NAMES};
+use crate::checkpoint::{self, CheckpointSink};
+use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
+use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -31,6 +36,23 @@ pub fn load(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
     let model = model::build(path, &scene, &resolved)?;
     let state = setup::generate(&model, &scene)?;
     Ok(Loaded { model, state })
+}
+
+/// A run continued from a checkpoint: its stored scenario (with any `--set`
+/// applied on top) and its state.
+pub fn load_checkpoint(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
+    let ck = checkpoint::load(path)?;
+    let label = format!("{path} (stored scenario {})", ck.header.scenario_file);
+    let (scene, resolved) = scene::parse_str(&label, &ck.header.scenario, sets)?;
+    let mut model = model::build(&label, &scene, &resolved)?;
+    model.file = ck.header.scenario_file.clone();
+    if ck.state.phase.iter().any(|&p| p as usize >= model.phases.len()) {
+        return Err(InputError::new(path, "", "checkpoint phases do not match its scenario"));
+    }
+    Ok(Loaded {
+        model,
+        state: ck.state,
+    })
 }
 
 pub fn make_backend(
@@ -58,6 +80,20 @@ pub fn make_backend(
 pub struct RunOptions {
     pub end: EndCondition,
     pub quiet: bool,
+    /// The state came from a checkpoint: it already holds accelerations and Δt,
+    /// so the priming passes are skipped (re-running them would change nothing in
+    /// positions but would recompute accelerations from full-step velocities).
+    pub resumed: bool,
+}
+
+/// Set by the SIGINT/SIGTERM handler; the step loop stops at the next step boundary.
+pub static STOP: AtomicBool = AtomicBool::new(false);
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunEnd {
+    Completed,
+    Interrupted,
+    Unstable(Trip),
 }
 
 pub struct RunReport {
@@ -67,11 +103,98 @@ pub struct RunReport {
     pub particles: usize,
     pub check: Option<CheckResult>,
     pub final_state: State,
+    pub end: RunEnd,
+    /// The checkpoint written last, if any.
+    pub last_checkpoint: Option<PathBuf>,
 }
 
 impl RunReport {
     pub fn particle_steps_per_s(&self) -> f64 {
         self.particles as f64 * self.steps as f64 / self.wall_s.max(1e-9)
+    }
+}
+
+/// Where a run writes: any of an MCAP stream, a VTK series and checkpoints.
+#[derive(Default)]
+pub struct Outputs {
+    pub mcap: Option<McapSink>,
+    pub vtk: Option<VtkSink>,
+    pub checkpoints: Option<CheckpointSink>,
+    /// Simulated time between periodic checkpoints; None writes them only at the end,
+    /// on interruption and on an instability stop.
+    pub checkpoint_every: Option<f64>,
+    pub backend: String,
+    last_diag_step: Option<u32>,
+    last_checkpoint: Option<PathBuf>,
+}
+
+impl Outputs {
+    fn frame(&mut self, m: &Model, st: &State) -> Result<(), String> {
+        if let Some(s) = self.mcap.as_mut() {
+            s.frame(m, st)?;
+        }
+        if let Some(v) = self.vtk.as_mut() {
+            v.frame(m, st)?;
+        }
+        Ok(())
+    }
+    fn diagnostics(&mut self, m: &Model, st: &State) -> Result<(), String> {
+        if self.last_diag_step == Some(st.sim.step) {
+            return Ok(());
+        }
+        self.last_diag_step = Some(st.sim.step);
+        match self.mcap.as_mut() {
+            Some(s) => s.diagnostics(&output::diagnostics(m, st)),
+            None => Ok(()),
+        }
+    }
+    fn checkpoint(&mut self, m: &Model, st: &State) -> Result<(), String> {
+        if let Some(c) = self.checkpoints.as_mut() {
+            self.last_checkpoint = Some(c.write(m, st, &self.backend)?);
+        }
+        Ok(())
+    }
+    /// Close every file properly (MCAP summary and footer).
+    pub fn finish(&mut self) -> Result<(), String> {
+        match self.mcap.as_mut() {
+            Some(s) => s.finish(),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Steps between host reads of Δt and time: about 2e6 particle-updates, at most
+/// 200 steps. It depends on the particle count only, so chunking (and with it the
+/// step a time-ended run stops at) is the same on every run and after a resume.
+fn chunk_cap(particles: usize) -> u64 {
+    (2_000_000 / particles.max(1) as u64).clamp(1, 200)
+}
+
+/// The first multiple of `interval` after `t` (∞ for an infinite interval).
+fn next_multiple(t: f64, interval: f64) -> f64 {
+    if !interval.is_finite() {
+        return f64::INFINITY;
+    }
+    ((t / interval + 1e-9).floor() + 1.0) * interval
+}
+
+/// Output schedule in simulated time.
+struct Schedule {
+    frame: f64,
+    diag: f64,
+    ckpt: f64,
+}
+
+impl Schedule {
+    fn new(m: &Model, t: f64, ckpt_every: Option<f64>) -> Schedule {
+        Schedule {
+            frame: next_multiple(t, m.output_interval),
+            diag: next_multiple(t, m.diagnostics_interval),
+            ckpt: ckpt_every.map_or(f64::INFINITY, |c| next_multiple(t, c)),
+        }
+    }
+    fn next(&self) -> f64 {
+        self.frame.min(self.diag).min(self.ckpt)
     }
 }
 
@@ -134,25 +257,38 @@ impl Progress {
     }
 }
 
-/// Run the step loop to the end condition, sampling state every output interval.
+/// Run the step loop to the end condition, writing outputs on the way. Every
+/// ending (completed, interrupted, unstable) writes a last frame; checkpoints go
+/// where `out.checkpoints` points.
 pub fn run(
     l: &Loaded,
     backend: &mut dyn Backend,
     opts: &RunOptions,
+    out: &mut Outputs,
 ) -> Result<RunReport, SpatterError> {
     let m = &l.model;
+    let rt = SpatterError::Runtime;
     let mut checker = Checker::new(m);
     let start = Instant::now();
-    backend.prime();
-    let mut progress = Progress::new(opts.quiet);
-    let mut next_sample = 0.0f64;
-    let mut steps_done = 0u64;
-    let mut sim = backend.read_sim();
-    if let Some(c) = checker.as_mut() {
-        c.observe(m, &backend.read_state());
+    if !opts.resumed {
+        backend.prime();
     }
-    next_sample += m.output_interval;
-    loop {
+    let mut progress = Progress::new(opts.quiet);
+    let mut st = backend.read_state();
+    let mut last_good = st.clone();
+    let mut sim = st.sim;
+    let start_step = sim.step as u64;
+    let mut sched = Schedule::new(m, sim.time as f64, out.checkpoint_every);
+    out.frame(m, &st).map_err(rt)?;
+    out.diagnostics(m, &st).map_err(rt)?;
+    if let Some(c) = checker.as_mut() {
+        c.observe(m, &st);
+    }
+    let cap = chunk_cap(st.len());
+    let mut steps_done = 0u64;
+    let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
+    let mut end = RunEnd::Completed;
+    while trip.is_none() {
         let t = sim.time as f64;
         let (done, frac) = match opts.end {
             EndCondition::Steps(n) => (steps_done >= n, steps_done as f64 / n.max(1) as f64),
@@ -161,54 +297,124 @@ pub fn run(
         if done {
             break;
         }
-        if !(sim.dt.is_finite() && sim.dt > 0.0) {
-            return Err(SpatterError::Runtime(format!(
-                "unstable: time step became {} at step {} (t = {t:.6e} s); the run stopped",
-                sim.dt, sim.step
-            )));
+        if STOP.load(Ordering::SeqCst) {
+            end = RunEnd::Interrupted;
+            break;
         }
-        // Steps until the next sample or the end, from the current Δt (it changes slowly).
         let target = match opts.end {
-            EndCondition::Time(te) => next_sample.min(te),
-            EndCondition::Steps(_) => next_sample,
+            EndCondition::Time(te) => sched.next().min(te),
+            EndCondition::Steps(_) => sched.next(),
         };
         let mut chunk = (((target - t) / sim.dt as f64).ceil().max(1.0)) as u64;
         if let EndCondition::Steps(n) = opts.end {
             chunk = chunk.min(n - steps_done);
         }
-        let chunk = chunk.min(200) as u32;
-        backend.run_steps(chunk);
-        steps_done += chunk as u64;
+        steps_done += run_interruptible(backend, chunk.min(cap));
         sim = backend.read_sim();
-        let rate = l.state.len() as f64 * steps_done as f64 / start.elapsed().as_secs_f64();
-        progress.update(
-            opts.quiet,
-            frac,
-            sim.time as f64,
-            steps_done,
-            sim.dt,
-            sim.dt_limit,
-            rate,
-        );
-        if sim.time as f64 >= next_sample - 1e-12 {
+        let rate = st.len() as f64 * steps_done as f64 / start.elapsed().as_secs_f64();
+        progress.update(opts.quiet, frac, sim.time as f64, steps_done, sim.dt, sim.dt_limit, rate);
+        trip = watchdog::check_sim(m, &sim);
+        let t = sim.time as f64;
+        let eps = 1e-12;
+        let due = (t >= sched.frame - eps, t >= sched.diag - eps, t >= sched.ckpt - eps);
+        if trip.is_some() || !(due.0 || due.1 || due.2) {
+            continue;
+        }
+        st = backend.read_state();
+        trip = watchdog::scan(m, &st);
+        if trip.is_some() {
+            continue;
+        }
+        last_good = st.clone();
+        if due.1 {
+            out.diagnostics(m, &st).map_err(rt)?;
+        }
+        if due.0 {
+            out.frame(m, &st).map_err(rt)?;
             if let Some(c) = checker.as_mut() {
-                c.observe(m, &backend.read_state());
-            }
-            while next_sample <= sim.time as f64 {
-                next_sample += m.output_interval;
+                c.observe(m, &st);
             }
         }
+        if due.2 {
+            out.checkpoint(m, &st).map_err(rt)?;
+        }
+        sched = Schedule::new(m, t, out.checkpoint_every);
     }
     progress.finish();
-    let final_state = backend.read_state();
+    let final_state = match trip {
+        Some(first) => {
+            let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first);
+            out.frame(m, &bad).map_err(rt)?;
+            out.diagnostics(m, &bad).map_err(rt)?;
+            out.checkpoint(m, &good).map_err(rt)?;
+            end = RunEnd::Unstable(precise);
+            bad
+        }
+        None => {
+            let fin = backend.read_state();
+            out.frame(m, &fin).map_err(rt)?;
+            out.diagnostics(m, &fin).map_err(rt)?;
+            if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
+                out.checkpoint(m, &fin).map_err(rt)?;
+            }
+            fin
+        }
+    };
+    out.finish().map_err(rt)?;
     let wall_s = start.elapsed().as_secs_f64();
-    let check = checker.as_mut().map(|c| c.finish(m, &final_state));
+    let check = match end {
+        RunEnd::Completed => checker.as_mut().map(|c| c.finish(m, &final_state)),
+        _ => None,
+    };
     Ok(RunReport {
-        steps: steps_done,
+        steps: final_state.sim.step as u64 - start_step,
         sim_time: final_state.sim.time as f64,
         wall_s,
         particles: final_state.len(),
         check,
         final_state,
+        end,
+        last_checkpoint: out.last_checkpoint.clone(),
     })
+}
+
+/// Run `n` steps in small batches, stopping early if a signal arrived.
+fn run_interruptible(backend: &mut dyn Backend, n: u64) -> u64 {
+    const BATCH: u64 = 8;
+    let mut done = 0;
+    while done < n {
+        if STOP.load(Ordering::SeqCst) {
+            break;
+        }
+        let k = (n - done).min(BATCH);
+        backend.run_steps(k as u32);
+        done += k;
+    }
+    done
+}
+
+/// Rewind to the last good state and step one at a time until the watchdog trips
+/// again, so the report names the first bad step. Returns the trip, the first bad
+/// state and the last good one. Steps are deterministic, so the replay meets the
+/// same failure; if it somehow does not within twice the distance, the original
+/// trip and the current state are reported.
+fn replay_to_trip(
+    m: &Model,
+    backend: &mut dyn Backend,
+    last_good: &State,
+    first: Trip,
+) -> (Trip, State, State) {
+    let span = (first.step.saturating_sub(last_good.sim.step as u64) + 1) * 2;
+    backend.load_state(last_good);
+    let mut good = last_good.clone();
+    for _ in 0..span {
+        backend.run_steps(1);
+        let st = backend.read_state();
+        if let Some(t) = watchdog::check_sim(m, &st.sim).or_else(|| watchdog::scan(m, &st)) {
+            return (t, st, good);
+        }
+        good = st;
+    }
+    let current = backend.read_state();
+    (first, current, good)
 }

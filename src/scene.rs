@@ -82,6 +82,8 @@ pub struct SceneFile {
     #[serde(default)]
     pub run: RunDef,
     pub check: Option<CheckDef>,
+    #[serde(default)]
+    pub watchdog: WatchdogDef,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -214,6 +216,41 @@ pub struct RunDef {
     pub dt: Option<f64>,
     /// Simulated time between state samples (checks, output frames).
     pub output_interval: Option<f64>,
+    /// Simulated time between `/diagnostics` messages and watchdog scans
+    /// (default: the output interval).
+    pub diagnostics_interval: Option<f64>,
+    /// Refuse a fixed `dt` above the F22 (42) limits (default true). Switching it off
+    /// is for deliberately unstable runs, such as testing the watchdog.
+    pub dt_check: Option<bool>,
+}
+
+/// Instability watchdog thresholds (issue 3). Densities are relative to each
+/// phase's ρ0, the Δt floor to the initial F22 (42) limit.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WatchdogDef {
+    pub enabled: bool,
+    /// Lower density bound ρ/ρ0. A lone particle keeps only its own kernel
+    /// contribution, m W(0) ≈ 0.1–0.3 ρ0 for the kernels here, so the bound sits below.
+    pub min_density_ratio: f64,
+    /// Upper density bound ρ/ρ0; weakly compressible flow stays within a few percent.
+    pub max_density_ratio: f64,
+    /// Δt below this fraction of the initial limit counts as a collapse.
+    pub min_dt_ratio: f64,
+    /// A fluid particle deeper than this many Δx behind a wall face has penetrated it.
+    pub wall_penetration: f64,
+}
+
+impl Default for WatchdogDef {
+    fn default() -> Self {
+        WatchdogDef {
+            enabled: true,
+            min_density_ratio: 0.02,
+            max_density_ratio: 3.0,
+            min_dt_ratio: 1e-3,
+            wall_penetration: 0.5,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -370,7 +407,14 @@ fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), I
     Ok(())
 }
 
-const RUN_KEYS: [&str; 4] = ["end_time", "steps", "dt", "output_interval"];
+const RUN_KEYS: [&str; 6] = [
+    "end_time",
+    "steps",
+    "dt",
+    "output_interval",
+    "diagnostics_interval",
+    "dt_check",
+];
 
 fn parse_value(raw: &str) -> toml::Value {
     let doc = format!("v = {raw}");

@@ -2,7 +2,7 @@
 //! stated (and justified) in the scene file.
 
 mod common;
-use spatter::run::{load, make_backend, run, BackendChoice, RunOptions};
+use spatter::run::{load, make_backend, run, BackendChoice, Outputs, RunOptions};
 
 fn check_passes(name: &str) -> f64 {
     let l = load(&common::scene(name), &[]).unwrap();
@@ -13,7 +13,9 @@ fn check_passes(name: &str) -> f64 {
         &RunOptions {
             end: l.model.end,
             quiet: true,
+            resumed: false,
         },
+        &mut Outputs::default(),
     )
     .unwrap();
     let c = r.check.expect("scene has a check");

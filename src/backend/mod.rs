@@ -126,6 +126,9 @@ pub trait Backend {
         }
     }
     fn read_state(&mut self) -> State;
+    /// Replace the device state with `st` (same particle count): resume from a
+    /// checkpoint, or rewind to the last good state when the watchdog trips.
+    fn load_state(&mut self, st: &State);
     fn read_sim(&mut self) -> Sim;
     /// Milliseconds per pass summed since the last call, where the backend measures them.
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {

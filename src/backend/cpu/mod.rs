@@ -88,6 +88,10 @@ impl Backend for CpuBackend {
     fn read_sim(&mut self) -> Sim {
         self.st.sim
     }
+    fn load_state(&mut self, st: &State) {
+        assert_eq!(st.len(), self.st.len(), "load_state: particle count changed");
+        self.st = st.clone();
+    }
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
         std::mem::take(&mut self.times)
     }

@@ -595,6 +595,10 @@ impl Backend for GpuBackend {
             sim: self.read_sim(),
         }
     }
+    fn load_state(&mut self, st: &State) {
+        assert_eq!(st.len() as u32, self.params.counts[0], "load_state: particle count changed");
+        self.upload(st);
+    }
     fn read_sim(&mut self) -> Sim {
         *bytemuck::from_bytes(&self.read_bytes(&self.buf.sim, std::mem::size_of::<Sim>() as u64))
     }

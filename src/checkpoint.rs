@@ -1,0 +1,193 @@
+//! Checkpoints: the full particle state plus the scenario that produced it, so
+//! `spatter run --resume FILE` continues bit-identically on the same backend.
+//!
+//! Layout (little-endian): magic `SPATCKPT`, u32 format version, u32 reserved,
+//! u64 header length, JSON header, then the arrays in `State` order (pos, vel, acc,
+//! acc_b as 4×f32; rho, p, mass as f32; phase, id as u32), the 32-byte `Sim`
+//! block, and a CRC-32 of everything before it. Files are written to a temporary
+//! name and renamed, so a checkpoint on disk is always complete.
+
+use crate::error::InputError;
+use crate::model::Model;
+use crate::state::{Sim, State};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+const MAGIC: &[u8; 8] = b"SPATCKPT";
+const FORMAT_VERSION: u32 = 1;
+/// Checkpoints kept per folder: the newest two, in case the newest is the one
+/// a failing disk truncated.
+const KEEP: usize = 2;
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Header {
+    pub spatter_version: String,
+    pub scenario_file: String,
+    /// Resolved scenario TOML (after `--set`).
+    pub scenario: String,
+    pub backend: String,
+    pub particles: u64,
+    pub step: u64,
+    pub time: f64,
+    pub dt: f64,
+    /// The only random stream is the seeded setup jitter; the step loop draws no
+    /// random numbers, so the seed is the whole RNG state.
+    pub rng_seed: u64,
+    pub rng_draws_after_setup: u64,
+}
+
+pub struct Checkpoint {
+    pub header: Header,
+    pub state: State,
+}
+
+fn push<T: bytemuck::Pod>(out: &mut Vec<u8>, v: &[T]) {
+    out.extend_from_slice(bytemuck::cast_slice(v));
+}
+
+pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
+    let header = Header {
+        spatter_version: env!("CARGO_PKG_VERSION").into(),
+        scenario_file: m.file.clone(),
+        scenario: m.resolved_toml.clone(),
+        backend: backend.into(),
+        particles: st.len() as u64,
+        step: st.sim.step as u64,
+        time: st.sim.time as f64,
+        dt: st.sim.dt as f64,
+        rng_seed: m.seed,
+        rng_draws_after_setup: 0,
+    };
+    let json = serde_json::to_vec(&header).expect("checkpoint header serializes");
+    let mut out = Vec::with_capacity(64 + json.len() + st.len() * 100);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&(json.len() as u64).to_le_bytes());
+    out.extend_from_slice(&json);
+    for v in [&st.pos, &st.vel, &st.acc, &st.acc_b] {
+        push(&mut out, v);
+    }
+    for v in [&st.rho, &st.p, &st.mass] {
+        push(&mut out, v);
+    }
+    for v in [&st.phase, &st.id] {
+        push(&mut out, v);
+    }
+    out.extend_from_slice(bytemuck::bytes_of(&st.sim));
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+struct Cursor<'a> {
+    buf: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let s = self.buf.get(self.at..self.at.checked_add(n)?)?;
+        self.at += n;
+        Some(s)
+    }
+    fn vec<T: bytemuck::Pod>(&mut self, n: usize) -> Option<Vec<T>> {
+        let bytes = self.take(n * std::mem::size_of::<T>())?;
+        Some(bytemuck::pod_collect_to_vec(bytes))
+    }
+    fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+}
+
+pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
+    let bad = |msg: &str| InputError::new(path, "", format!("not a readable spatter checkpoint: {msg}"));
+    if bytes.len() < 28 || &bytes[..8] != MAGIC {
+        return Err(bad("wrong magic bytes"));
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    if crc32fast::hash(body).to_le_bytes() != crc {
+        return Err(bad("CRC mismatch (file truncated or damaged)"));
+    }
+    let mut c = Cursor { buf: body, at: 8 };
+    let version = c.u32().ok_or_else(|| bad("short file"))?;
+    if version != FORMAT_VERSION {
+        return Err(bad(&format!("format version {version}, this spatter reads {FORMAT_VERSION}")));
+    }
+    c.u32();
+    let hlen = c.u64().ok_or_else(|| bad("short file"))? as usize;
+    let header: Header = c
+        .take(hlen)
+        .and_then(|h| serde_json::from_slice(h).ok())
+        .ok_or_else(|| bad("damaged header"))?;
+    let n = header.particles as usize;
+    let short = || bad("particle arrays shorter than the header says");
+    let state = State {
+        pos: c.vec(n).ok_or_else(short)?,
+        vel: c.vec(n).ok_or_else(short)?,
+        acc: c.vec(n).ok_or_else(short)?,
+        acc_b: c.vec(n).ok_or_else(short)?,
+        rho: c.vec(n).ok_or_else(short)?,
+        p: c.vec(n).ok_or_else(short)?,
+        mass: c.vec(n).ok_or_else(short)?,
+        phase: c.vec(n).ok_or_else(short)?,
+        id: c.vec(n).ok_or_else(short)?,
+        sim: *bytemuck::from_bytes::<Sim>(c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?),
+    };
+    if c.at != body.len() {
+        return Err(bad("trailing bytes after the state"));
+    }
+    Ok(Checkpoint { header, state })
+}
+
+pub fn load(path: &str) -> Result<Checkpoint, InputError> {
+    let bytes = std::fs::read(path).map_err(|e| InputError::new(path, "", format!("cannot read checkpoint: {e}")))?;
+    decode(path, &bytes)
+}
+
+/// Writes numbered checkpoints into one folder and keeps the newest `KEEP`.
+pub struct CheckpointSink {
+    dir: PathBuf,
+    written: Vec<PathBuf>,
+}
+
+impl CheckpointSink {
+    /// The folder is made on the first write, so a run that never checkpoints
+    /// leaves none behind.
+    pub fn create(dir: &str) -> Result<CheckpointSink, String> {
+        if Path::new(dir).is_file() {
+            return Err(format!("{dir}: is a file, not a folder for checkpoints"));
+        }
+        Ok(CheckpointSink {
+            dir: PathBuf::from(dir),
+            written: Vec::new(),
+        })
+    }
+
+    /// Write a checkpoint named by its step; returns its path.
+    pub fn write(&mut self, m: &Model, st: &State, backend: &str) -> Result<PathBuf, String> {
+        let path = self.dir.join(format!("step_{:010}.ckpt", st.sim.step));
+        if self.written.last() == Some(&path) {
+            return Ok(path);
+        }
+        std::fs::create_dir_all(&self.dir)
+            .map_err(|e| format!("{}: cannot create checkpoint folder: {e}", self.dir.display()))?;
+        write_atomic(&path, &encode(m, st, backend))?;
+        self.written.push(path.clone());
+        while self.written.len() > KEEP {
+            let old = self.written.remove(0);
+            let _ = std::fs::remove_file(old);
+        }
+        Ok(path)
+    }
+}
+
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
+}

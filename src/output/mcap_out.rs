@@ -1,0 +1,145 @@
+//! MCAP stream: `/particles` (foxglove.PointCloud, protobuf) and `/diagnostics`
+//! (JSON with a JSON schema), zstd-compressed chunks, the resolved scenario as
+//! metadata. Every message closes its chunk and flushes, so a process killed hard
+//! leaves a file readable up to its last message; `finish` (or Drop) writes the
+//! summary and footer on every other ending.
+
+use super::pointcloud;
+use super::{diagnostics_schema, particle_fields, time_ns, Diagnostics};
+use crate::model::Model;
+use crate::state::State;
+use mcap::records::{MessageHeader, Metadata};
+use mcap::{WriteOptions, Writer};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+
+pub const PARTICLES_TOPIC: &str = "/particles";
+pub const DIAGNOSTICS_TOPIC: &str = "/diagnostics";
+/// Name of the metadata record holding the run's provenance.
+pub const METADATA_NAME: &str = "spatter";
+
+pub struct McapSink {
+    path: String,
+    writer: Option<Writer<BufWriter<File>>>,
+    particles: u16,
+    diagnostics: u16,
+    sequence: u32,
+    pub frames: u64,
+    last_frame_step: Option<u32>,
+}
+
+/// What the file records so the run can be reproduced from it.
+pub struct Provenance<'a> {
+    pub backend: &'a str,
+    pub command: &'a str,
+}
+
+impl McapSink {
+    pub fn create(path: &str, m: &Model, prov: &Provenance) -> Result<McapSink, String> {
+        let err = |e: &dyn std::fmt::Display| format!("{path}: cannot write MCAP: {e}");
+        let file = File::create(path).map_err(|e| err(&e))?;
+        let mut w = WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .profile("")
+            .library(format!("spatter {}", env!("CARGO_PKG_VERSION")))
+            .create(BufWriter::new(file))
+            .map_err(|e| err(&e))?;
+        let pc_schema = w
+            .add_schema(
+                pointcloud::SCHEMA_NAME,
+                "protobuf",
+                &pointcloud::schema_descriptor_set(),
+            )
+            .map_err(|e| err(&e))?;
+        let diag_schema = w
+            .add_schema(
+                "spatter.Diagnostics",
+                "jsonschema",
+                diagnostics_schema(m).to_string().as_bytes(),
+            )
+            .map_err(|e| err(&e))?;
+        let none = BTreeMap::new();
+        let particles = w
+            .add_channel(pc_schema, PARTICLES_TOPIC, "protobuf", &none)
+            .map_err(|e| err(&e))?;
+        let diagnostics = w
+            .add_channel(diag_schema, DIAGNOSTICS_TOPIC, "json", &none)
+            .map_err(|e| err(&e))?;
+        let meta = BTreeMap::from([
+            ("spatter_version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
+            ("backend".to_string(), prov.backend.to_string()),
+            ("command".to_string(), prov.command.to_string()),
+            ("scenario_file".to_string(), m.file.clone()),
+            ("scenario".to_string(), m.resolved_toml.clone()),
+        ]);
+        w.write_metadata(&Metadata {
+            name: METADATA_NAME.into(),
+            metadata: meta,
+        })
+        .map_err(|e| err(&e))?;
+        w.flush().map_err(|e| err(&e))?;
+        Ok(McapSink {
+            path: path.to_string(),
+            writer: Some(w),
+            particles,
+            diagnostics,
+            sequence: 0,
+            frames: 0,
+            last_frame_step: None,
+        })
+    }
+
+    fn write(&mut self, channel: u16, t: f64, data: &[u8]) -> Result<(), String> {
+        let path = &self.path;
+        let w = self
+            .writer
+            .as_mut()
+            .ok_or_else(|| format!("{path}: MCAP already finished"))?;
+        let header = MessageHeader {
+            channel_id: channel,
+            sequence: self.sequence,
+            log_time: time_ns(t),
+            publish_time: time_ns(t),
+        };
+        self.sequence += 1;
+        w.write_to_known_channel(&header, data)
+            .and_then(|_| w.flush())
+            .map_err(|e| format!("{path}: cannot write MCAP: {e}"))
+    }
+
+    /// One `/particles` frame of the whole state (skipped if this step is written).
+    pub fn frame(&mut self, m: &Model, st: &State) -> Result<(), String> {
+        if self.last_frame_step == Some(st.sim.step) {
+            return Ok(());
+        }
+        let t = st.sim.time as f64;
+        let data = pointcloud::encode_frame(t, &particle_fields(m, st));
+        self.write(self.particles, t, &data)?;
+        self.frames += 1;
+        self.last_frame_step = Some(st.sim.step);
+        Ok(())
+    }
+
+    pub fn diagnostics(&mut self, d: &Diagnostics) -> Result<(), String> {
+        let json = serde_json::to_vec(d).map_err(|e| e.to_string())?;
+        self.write(self.diagnostics, d.time, &json)
+    }
+
+    /// Write the summary and footer. Safe to call more than once.
+    pub fn finish(&mut self) -> Result<(), String> {
+        if let Some(mut w) = self.writer.take() {
+            w.finish()
+                .map_err(|e| format!("{}: cannot finish MCAP: {e}", self.path))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for McapSink {
+    fn drop(&mut self) {
+        // Any ending that skipped `finish` (an error path, a panic unwinding) still
+        // leaves a complete file.
+        let _ = self.finish();
+    }
+}

@@ -1,0 +1,167 @@
+//! Run outputs (issue 3): the per-particle fields every format writes, the
+//! diagnostics record, and the sinks (MCAP stream, VTK series, checkpoints).
+//!
+//! One list of fields (`particle_fields`) feeds both MCAP and VTK, so a field added
+//! to the state appears in every format at once.
+
+pub mod mcap_out;
+pub mod pointcloud;
+pub mod vtk;
+
+use crate::model::Model;
+use crate::scene::PhaseKind;
+use crate::state::{State, DT_LIMIT_NAMES};
+use serde::Serialize;
+
+/// Values of one per-particle field, in particle (array) order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    F32(Vec<f32>),
+    U32(Vec<u32>),
+}
+
+impl Values {
+    pub fn len(&self) -> usize {
+        match self {
+            Values::F32(v) => v.len(),
+            Values::U32(v) => v.len(),
+        }
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Little-endian bytes of element `i`.
+    pub fn le_bytes(&self, i: usize) -> [u8; 4] {
+        match self {
+            Values::F32(v) => v[i].to_le_bytes(),
+            Values::U32(v) => v[i].to_le_bytes(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    pub name: &'static str,
+    pub values: Values,
+}
+
+/// World position of particle `i`, axis `a`, as written to every output: the stored
+/// grid-relative f32 position plus the grid origin, rounded once to f32.
+pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
+    if a >= m.dim as usize {
+        return 0.0;
+    }
+    (st.pos[i][a] as f64 + m.origin[a]) as f32
+}
+
+/// Every per-particle field a frame carries: x, y, z (m), vx, vy, vz (m/s), density
+/// (kg/m³), pressure (Pa), mass (kg), phase (index into the scene's phases) and id
+/// (the particle's index at setup, stable across reordering).
+pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
+    let n = st.len();
+    let coord = |a: usize| Values::F32((0..n).map(|i| world_coord(m, st, i, a)).collect());
+    let vel = |a: usize| Values::F32(st.vel.iter().map(|v| v[a]).collect());
+    let f = |name, values| Field { name, values };
+    vec![
+        f("x", coord(0)),
+        f("y", coord(1)),
+        f("z", coord(2)),
+        f("vx", vel(0)),
+        f("vy", vel(1)),
+        f("vz", vel(2)),
+        f("density", Values::F32(st.rho.clone())),
+        f("pressure", Values::F32(st.p.clone())),
+        f("mass", Values::F32(st.mass.clone())),
+        f("phase", Values::U32(st.phase.clone())),
+        f("id", Values::U32(st.id.clone())),
+    ]
+}
+
+/// One `/diagnostics` record. Fluid particles only: wall particles carry
+/// extrapolated velocities and pressures, not a state of their own.
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagnostics {
+    pub time: f64,
+    pub step: u64,
+    pub dt: f64,
+    pub dt_limit: String,
+    /// J (per metre of depth in 2D).
+    pub kinetic_energy: f64,
+    /// kg (per metre of depth in 2D).
+    pub total_mass: f64,
+    pub max_speed: f64,
+    pub min_density: f64,
+    pub max_density: f64,
+    pub particles: std::collections::BTreeMap<String, u64>,
+}
+
+pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
+    let mut d = Diagnostics {
+        time: st.sim.time as f64,
+        step: st.sim.step as u64,
+        dt: st.sim.dt as f64,
+        dt_limit: DT_LIMIT_NAMES[st.sim.dt_limit as usize % 4].to_string(),
+        kinetic_energy: 0.0,
+        total_mass: 0.0,
+        max_speed: 0.0,
+        min_density: f64::INFINITY,
+        max_density: f64::NEG_INFINITY,
+        particles: m.phases.iter().map(|p| (p.name.clone(), 0)).collect(),
+    };
+    for i in 0..st.len() {
+        let phase = &m.phases[st.phase[i] as usize];
+        *d.particles.entry(phase.name.clone()).or_default() += 1;
+        if phase.kind == PhaseKind::Wall {
+            continue;
+        }
+        let v = st.vel[i];
+        let v2 = (0..3).map(|a| (v[a] as f64).powi(2)).sum::<f64>();
+        let mass = st.mass[i] as f64;
+        d.kinetic_energy += 0.5 * mass * v2;
+        d.total_mass += mass;
+        d.max_speed = d.max_speed.max(v2.sqrt());
+        d.min_density = d.min_density.min(st.rho[i] as f64);
+        d.max_density = d.max_density.max(st.rho[i] as f64);
+    }
+    if !d.min_density.is_finite() {
+        (d.min_density, d.max_density) = (0.0, 0.0);
+    }
+    d
+}
+
+/// JSON schema of a `/diagnostics` message (Foxglove's plot panel reads the numbers).
+pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    let per_depth = if m.dim == 2 { " per metre of depth" } else { "" };
+    let phases: serde_json::Map<String, serde_json::Value> = m
+        .phases
+        .iter()
+        .map(|p| (p.name.clone(), serde_json::json!({"type": "integer"})))
+        .collect();
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Diagnostics",
+        "type": "object",
+        "properties": {
+            "time": num("simulated time, s"),
+            "step": {"type": "integer", "description": "step number"},
+            "dt": num("time step the next step takes, s"),
+            "dt_limit": {"type": "string", "enum": DT_LIMIT_NAMES,
+                         "description": "F22 (42) limit that binds dt"},
+            "kinetic_energy": num(&format!("fluid kinetic energy, J{per_depth}")),
+            "total_mass": num(&format!("fluid mass, kg{per_depth}")),
+            "max_speed": num("largest fluid speed, m/s"),
+            "min_density": num("smallest fluid density, kg/m^3"),
+            "max_density": num("largest fluid density, kg/m^3"),
+            "particles": {"type": "object", "properties": phases,
+                          "description": "particle count per phase"}
+        },
+        "required": ["time", "step", "dt", "dt_limit", "kinetic_energy", "total_mass",
+                     "max_speed", "min_density", "max_density", "particles"]
+    })
+}
+
+/// Simulated time in nanoseconds, the MCAP log time of a frame.
+pub fn time_ns(t: f64) -> u64 {
+    (t.max(0.0) * 1e9).round() as u64
+}

@@ -1,0 +1,152 @@
+//! Instability watchdog (issue 3): scans a state for the first sign that a run has
+//! gone wrong and names the step, time, particle, field and value.
+//!
+//! It looks at every state the run reads back (each diagnostics interval) and at
+//! Δt after every chunk; when it trips, the run replays from the last good state
+//! one step at a time, so the report names the first bad step, not the scan that
+//! noticed it.
+
+use crate::model::Model;
+use crate::scene::PhaseKind;
+use crate::state::{Sim, State};
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trip {
+    pub step: u64,
+    pub time: f64,
+    /// Particle id (stable across reordering); None for a global quantity (Δt).
+    pub particle: Option<u32>,
+    pub field: String,
+    pub value: f64,
+    pub reason: String,
+}
+
+impl Trip {
+    pub fn message(&self) -> String {
+        let who = match self.particle {
+            Some(id) => format!("particle {id}"),
+            None => "whole run".to_string(),
+        };
+        format!(
+            "unstable at step {}, t = {:.6e} s: {who}, field {} = {:e} ({})",
+            self.step, self.time, self.field, self.value, self.reason
+        )
+    }
+}
+
+/// Δt not finite, not positive or collapsed below the floor.
+pub fn check_sim(m: &Model, sim: &Sim) -> Option<Trip> {
+    let floor = m.watchdog.min_dt_ratio * m.limits.min().0;
+    let dt = sim.dt as f64;
+    let reason = if !dt.is_finite() {
+        "time step is not finite".to_string()
+    } else if dt <= 0.0 {
+        "time step is not positive".to_string()
+    } else if dt < floor {
+        format!("time step collapsed below {floor:e} s ({} of the initial limit)", m.watchdog.min_dt_ratio)
+    } else {
+        return None;
+    };
+    Some(Trip {
+        step: sim.step as u64,
+        time: sim.time as f64,
+        particle: None,
+        field: "dt".into(),
+        value: dt,
+        reason,
+    })
+}
+
+/// The first problem in `st`, by particle id, or None when the state is sane.
+pub fn scan(m: &Model, st: &State) -> Option<Trip> {
+    if !m.watchdog.enabled {
+        return None;
+    }
+    let mut worst: Option<(u32, &'static str, f64, String)> = None;
+    for i in 0..st.len() {
+        let id = st.id[i];
+        if worst.as_ref().is_some_and(|w| w.0 <= id) {
+            continue;
+        }
+        if let Some((field, value, reason)) = particle_problem(m, st, i) {
+            worst = Some((id, field, value, reason));
+        }
+    }
+    let (id, field, value, reason) = worst?;
+    Some(Trip {
+        step: st.sim.step as u64,
+        time: st.sim.time as f64,
+        particle: Some(id),
+        field: field.into(),
+        value,
+        reason,
+    })
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
+    let vec_fields: [(&'static str, &[f32; 4]); 4] = [
+        ("position", &st.pos[i]),
+        ("velocity", &st.vel[i]),
+        ("acceleration", &st.acc[i]),
+        ("transport_acceleration", &st.acc_b[i]),
+    ];
+    for (name, v) in vec_fields {
+        if let Some(&x) = v[..m.dim as usize].iter().find(|x| !x.is_finite()) {
+            return Some((name, x as f64, "not finite".into()));
+        }
+    }
+    for (name, x) in [("density", st.rho[i]), ("pressure", st.p[i])] {
+        if !x.is_finite() {
+            return Some((name, x as f64, "not finite".into()));
+        }
+    }
+    let phase = &m.phases[st.phase[i] as usize];
+    if phase.kind == PhaseKind::Wall {
+        return None;
+    }
+    if let Some(p) = position_problem(m, st, i) {
+        return Some(p);
+    }
+    let ratio = st.rho[i] as f64 / phase.rho0;
+    let wd = &m.watchdog;
+    if ratio < wd.min_density_ratio || ratio > wd.max_density_ratio {
+        return Some((
+            "density",
+            st.rho[i] as f64,
+            format!(
+                "outside {}..{} x rho0 of phase {}",
+                wd.min_density_ratio, wd.max_density_ratio, phase.name
+            ),
+        ));
+    }
+    None
+}
+
+/// A fluid particle behind a wall face, or far outside the domain through an open side.
+fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
+    let depth = m.watchdog.wall_penetration * m.dx;
+    for a in 0..m.dim as usize {
+        if m.periodic[a] {
+            continue;
+        }
+        let x = st.pos[i][a] as f64 + m.origin[a];
+        let (lo, hi) = (m.domain_lo[a], m.domain_hi[a]);
+        // Through an open side, a splash may leave; one domain length out it is lost.
+        let span = hi - lo;
+        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
+            let open = m.open_sides[a][side];
+            let limit = if open { span } else { depth };
+            if beyond > limit {
+                let what = if open {
+                    format!("left the domain through its open {} side", crate::scene::SIDE_NAMES[a][side])
+                } else {
+                    format!("penetrated the {} wall by {:.2} dx", crate::scene::SIDE_NAMES[a][side], beyond / m.dx)
+                };
+                return Some((AXES[a], x, what));
+            }
+        }
+    }
+    None
+}

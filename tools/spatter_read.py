@@ -1,0 +1,206 @@
+#!/usr/bin/env python3
+"""Read spatter run outputs: MCAP streams and VTK series.
+
+Set up its environment once (from the repository root):
+    python3 -m venv .venv && .venv/bin/pip install -r tools/requirements.txt
+
+Commands:
+    spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span
+    spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
+    spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
+    spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
+
+As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
+(time, {field: numpy array}); read_vtu(path) -> {field: numpy array}.
+A file whose writer was killed (no summary) is read up to its last complete chunk.
+"""
+import json
+import re
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+from mcap.decoder import DecoderFactory as McapDecoderFactory
+from mcap.reader import NonSeekingReader, make_reader
+from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoderFactory
+
+# foxglove.PackedElementField.NumericType -> numpy little-endian type
+NUMERIC_TYPES = {1: "u1", 2: "i1", 3: "<u2", 4: "<i2", 5: "<u4", 6: "<i4", 7: "<f4", 8: "<f8"}
+
+
+def pointcloud_to_arrays(msg):
+    """foxglove.PointCloud -> {field name: numpy array}, one entry per point."""
+    dtype = np.dtype({
+        "names": [f.name for f in msg.fields],
+        "formats": [NUMERIC_TYPES[f.type] for f in msg.fields],
+        "offsets": [f.offset for f in msg.fields],
+        "itemsize": msg.point_stride,
+    })
+    points = np.frombuffer(msg.data, dtype=dtype)
+    return {name: np.ascontiguousarray(points[name]) for name in dtype.names}
+
+
+class JsonDecoderFactory(McapDecoderFactory):
+    """/diagnostics: JSON messages described by a JSON schema."""
+
+    def decoder_for(self, message_encoding, schema):
+        if message_encoding == "json":
+            return json.loads
+        return None
+
+
+DECODERS = [ProtobufDecoderFactory(), JsonDecoderFactory()]
+
+
+def is_complete(path):
+    """True when the file has its summary and footer (the writer finished)."""
+    with open(path, "rb") as f:
+        try:
+            return make_reader(f).get_summary() is not None
+        except Exception:  # no footer: the writer was killed
+            return False
+
+
+def _messages(path):
+    """Decoded messages; an unfinished file is read record by record up to the
+    last complete chunk."""
+    with open(path, "rb") as f:
+        if is_complete(path):
+            yield from make_reader(f, decoder_factories=DECODERS).iter_decoded_messages()
+            return
+        reader = NonSeekingReader(f, validate_crcs=False, decoder_factories=DECODERS)
+        try:
+            yield from reader.iter_decoded_messages()
+        except Exception as e:  # the truncated tail; everything before it is intact
+            print(f"{path}: unfinished file, read up to its last complete chunk ({e})", file=sys.stderr)
+
+
+def read_mcap(path):
+    frames, diagnostics = [], []
+    info = {"schemas": {}, "metadata": {}}
+    for schema, channel, message, decoded in _messages(path):
+        info["schemas"][channel.topic] = schema.name if schema else ""
+        if channel.topic == "/particles":
+            frames.append((message.log_time * 1e-9, pointcloud_to_arrays(decoded)))
+        elif channel.topic == "/diagnostics":
+            diagnostics.append(decoded)
+    info["complete"] = is_complete(path)
+    if info["complete"]:
+        with open(path, "rb") as f:
+            for record in make_reader(f).iter_metadata():
+                info["metadata"][record.name] = dict(record.metadata)
+    return frames, diagnostics, info
+
+
+def read_vtu(path):
+    """A spatter .vtu (raw appended, UInt64 headers) -> {array name: numpy array}."""
+    raw = Path(path).read_bytes()
+    marker = raw.index(b"<AppendedData")
+    start = raw.index(b"_", marker) + 1
+    header = raw[:marker].decode()
+    types = {"Float32": "<f4", "UInt32": "<u4", "Int64": "<i8", "UInt8": "u1"}
+    arrays = {}
+    for m in re.finditer(r"<DataArray ([^>]*)/>", header):
+        attrs = dict(re.findall(r'(\w+)="([^"]*)"', m.group(1)))
+        offset = start + int(attrs["offset"])
+        size = int.from_bytes(raw[offset:offset + 8], "little")
+        data = np.frombuffer(raw[offset + 8:offset + 8 + size], dtype=types[attrs["type"]])
+        comps = int(attrs.get("NumberOfComponents", "1"))
+        arrays[attrs.get("Name", "points")] = data.reshape(-1, comps) if comps > 1 else data
+    return arrays
+
+
+def read_pvd(directory):
+    """[(time, .vtu path)] from particles.pvd."""
+    root = ET.parse(Path(directory) / "particles.pvd").getroot()
+    return [(float(d.get("timestep")), Path(directory) / d.get("file")) for d in root.iter("DataSet")]
+
+
+def summary(path):
+    frames, diagnostics, info = read_mcap(path)
+    times = [t for t, _ in frames]
+    return {
+        "frames": len(frames),
+        "particles_per_frame": sorted({len(a["x"]) for _, a in frames}),
+        "fields": list(frames[0][1].keys()) if frames else [],
+        "diagnostics": len(diagnostics),
+        "time_span": [min(times), max(times)] if times else [],
+        "last_diagnostics": diagnostics[-1] if diagnostics else None,
+        "schemas": info["schemas"],
+        "complete": info["complete"],
+        "has_scenario": "scenario" in info["metadata"].get("spatter", {}),
+    }
+
+
+def plot(path, png):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    _, diagnostics, _ = read_mcap(path)
+    t = np.array([d["time"] for d in diagnostics])
+    panels = [("kinetic_energy", "kinetic energy (J)"), ("max_speed", "max speed (m/s)"),
+              ("min_density", "density (kg/m³)"), ("dt", "Δt (s)")]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(7, 9), sharex=True)
+    for ax, (key, label) in zip(axes, panels):
+        ax.plot(t, [d[key] for d in diagnostics], marker=".")
+        if key == "min_density":
+            ax.plot(t, [d["max_density"] for d in diagnostics], marker=".")
+            ax.legend(["min", "max"])
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("simulated time (s)")
+    fig.suptitle(Path(path).name)
+    fig.tight_layout()
+    fig.savefig(png, dpi=100)
+
+
+def export_last(path, directory):
+    frames, _, _ = read_mcap(path)
+    if not frames:
+        raise SystemExit(f"{path}: no /particles frame")
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    t, arrays = frames[-1]
+    for name, values in arrays.items():
+        suffix = "u32" if values.dtype.kind == "u" else "f32"
+        values.astype("<u4" if suffix == "u32" else "<f4").tofile(out / f"{name}.{suffix}")
+    (out / "frame.json").write_text(json.dumps({"time": t, "particles": len(arrays["x"])}))
+
+
+def compare_vtk(path, directory):
+    frames, _, _ = read_mcap(path)
+    _, last_vtu = read_pvd(directory)[-1]
+    vtu = read_vtu(last_vtu)
+    _, mc = frames[-1]
+    points = np.stack([mc["x"], mc["y"], mc["z"]], axis=1)
+    velocity = np.stack([mc["vx"], mc["vy"], mc["vz"]], axis=1)
+    checks = {"positions": np.array_equal(points, vtu["points"]),
+              "velocity": np.array_equal(velocity, vtu["velocity"])}
+    for name in ("density", "pressure", "mass", "phase", "id"):
+        checks[name] = np.array_equal(mc[name], vtu[name])
+    print(json.dumps({"vtu": str(last_vtu), "particles": len(points), "equal": checks}))
+    return all(checks.values())
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__)
+        return 2
+    cmd, path = argv[1], argv[2]
+    if cmd == "summary":
+        print(json.dumps(summary(path)))
+    elif cmd == "plot" and len(argv) == 4:
+        plot(path, argv[3])
+    elif cmd == "export-last" and len(argv) == 4:
+        export_last(path, argv[3])
+    elif cmd == "compare-vtk" and len(argv) == 4:
+        return 0 if compare_vtk(path, argv[3]) else 1
+    else:
+        print(__doc__)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -104,7 +104,13 @@ impl<'a> Cursor<'a> {
 }
 
 pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
-    let bad = |msg: &str| InputError::new(path, "", format!("not a readable spatter checkpoint: {msg}"));
+    let bad = |msg: &str| {
+        InputError::new(
+            path,
+            "",
+            format!("not a readable spatter checkpoint: {msg}"),
+        )
+    };
     if bytes.len() < 28 || &bytes[..8] != MAGIC {
         return Err(bad("wrong magic bytes"));
     }
@@ -115,7 +121,9 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
     let mut c = Cursor { buf: body, at: 8 };
     let version = c.u32().ok_or_else(|| bad("short file"))?;
     if version != FORMAT_VERSION {
-        return Err(bad(&format!("format version {version}, this spatter reads {FORMAT_VERSION}")));
+        return Err(bad(&format!(
+            "format version {version}, this spatter reads {FORMAT_VERSION}"
+        )));
     }
     c.u32();
     let hlen = c.u64().ok_or_else(|| bad("short file"))? as usize;
@@ -135,7 +143,9 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         mass: c.vec(n).ok_or_else(short)?,
         phase: c.vec(n).ok_or_else(short)?,
         id: c.vec(n).ok_or_else(short)?,
-        sim: *bytemuck::from_bytes::<Sim>(c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?),
+        sim: bytemuck::pod_read_unaligned::<Sim>(
+            c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?,
+        ),
     };
     if c.at != body.len() {
         return Err(bad("trailing bytes after the state"));
@@ -144,7 +154,8 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
 }
 
 pub fn load(path: &str) -> Result<Checkpoint, InputError> {
-    let bytes = std::fs::read(path).map_err(|e| InputError::new(path, "", format!("cannot read checkpoint: {e}")))?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read checkpoint: {e}")))?;
     decode(path, &bytes)
 }
 
@@ -173,8 +184,12 @@ impl CheckpointSink {
         if self.written.last() == Some(&path) {
             return Ok(path);
         }
-        std::fs::create_dir_all(&self.dir)
-            .map_err(|e| format!("{}: cannot create checkpoint folder: {e}", self.dir.display()))?;
+        std::fs::create_dir_all(&self.dir).map_err(|e| {
+            format!(
+                "{}: cannot create checkpoint folder: {e}",
+                self.dir.display()
+            )
+        })?;
         write_atomic(&path, &encode(m, st, backend))?;
         self.written.push(path.clone());
         while self.written.len() > KEEP {

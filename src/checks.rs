@@ -119,7 +119,7 @@ impl Checker {
         };
         let pass = value.is_finite() && value <= self.tolerance;
         CheckResult {
-            name: format!("{:?}", self.kind).to_lowercase(),
+            name: self.kind.name().into(),
             metric,
             value,
             tolerance: self.tolerance,

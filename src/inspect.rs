@@ -32,7 +32,8 @@ pub struct Inspection {
 }
 
 pub fn inspect(path: &str) -> Result<Inspection, SpatterError> {
-    let buf = std::fs::read(path).map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    let buf =
+        std::fs::read(path).map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
     if !buf.starts_with(mcap::MAGIC) {
         return Err(InputError::new(path, "", "not an MCAP file (no magic bytes)").into());
     }
@@ -40,7 +41,11 @@ pub fn inspect(path: &str) -> Result<Inspection, SpatterError> {
     let (stats, stopped_early) = message_stats(&buf);
     let metadata = spatter_metadata(&buf);
     let mut text = String::new();
-    let _ = writeln!(text, "file: {path} ({:.2} MiB)", buf.len() as f64 / 1048576.0);
+    let _ = writeln!(
+        text,
+        "file: {path} ({:.2} MiB)",
+        buf.len() as f64 / 1048576.0
+    );
     let _ = writeln!(
         text,
         "complete: {}",
@@ -51,7 +56,10 @@ pub fn inspect(path: &str) -> Result<Inspection, SpatterError> {
         }
     );
     if let Some(e) = &stopped_early {
-        let _ = writeln!(text, "reading stopped at a damaged or truncated record: {e}");
+        let _ = writeln!(
+            text,
+            "reading stopped at a damaged or truncated record: {e}"
+        );
     }
     for key in ["spatter_version", "backend", "command", "scenario_file"] {
         if let Some(v) = metadata.get(key) {
@@ -89,7 +97,10 @@ pub fn inspect(path: &str) -> Result<Inspection, SpatterError> {
     Ok(Inspection {
         complete,
         stopped_early,
-        channels: stats.iter().map(|(k, v)| (k.clone(), (v.messages, v.points))).collect(),
+        channels: stats
+            .iter()
+            .map(|(k, v)| (k.clone(), (v.messages, v.points)))
+            .collect(),
         metadata,
         text,
     })

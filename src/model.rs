@@ -279,7 +279,10 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
         return Err(cx.err(
             "watchdog.max_density_ratio",
-            format!("must be a finite number above 1 (got {})", wd.max_density_ratio),
+            format!(
+                "must be a finite number above 1 (got {})",
+                wd.max_density_ratio
+            ),
         ));
     }
     if wd.min_density_ratio >= 1.0 {

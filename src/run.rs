@@ -3,15 +3,15 @@
 use crate::backend::cpu::CpuBackend;
 use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
 use crate::backend::Backend;
+use crate::checkpoint::{self, CheckpointSink};
 use crate::checks::{CheckResult, Checker};
 use crate::error::{InputError, SpatterError};
 use crate::model::{self, EndCondition, Model};
+use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
 use crate::params::Params;
 use crate::scene;
 use crate::setup;
 use crate::state::{State, DT_LIMIT_NAMES};
-use crate::checkpoint::{self, CheckpointSink};
-use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
 use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -46,8 +46,17 @@ pub fn load_checkpoint(path: &str, sets: &[String]) -> Result<Loaded, InputError
     let (scene, resolved) = scene::parse_str(&label, &ck.header.scenario, sets)?;
     let mut model = model::build(&label, &scene, &resolved)?;
     model.file = ck.header.scenario_file.clone();
-    if ck.state.phase.iter().any(|&p| p as usize >= model.phases.len()) {
-        return Err(InputError::new(path, "", "checkpoint phases do not match its scenario"));
+    if ck
+        .state
+        .phase
+        .iter()
+        .any(|&p| p as usize >= model.phases.len())
+    {
+        return Err(InputError::new(
+            path,
+            "",
+            "checkpoint phases do not match its scenario",
+        ));
     }
     Ok(Loaded {
         model,
@@ -312,11 +321,23 @@ pub fn run(
         steps_done += run_interruptible(backend, chunk.min(cap));
         sim = backend.read_sim();
         let rate = st.len() as f64 * steps_done as f64 / start.elapsed().as_secs_f64();
-        progress.update(opts.quiet, frac, sim.time as f64, steps_done, sim.dt, sim.dt_limit, rate);
+        progress.update(
+            opts.quiet,
+            frac,
+            sim.time as f64,
+            steps_done,
+            sim.dt,
+            sim.dt_limit,
+            rate,
+        );
         trip = watchdog::check_sim(m, &sim);
         let t = sim.time as f64;
         let eps = 1e-12;
-        let due = (t >= sched.frame - eps, t >= sched.diag - eps, t >= sched.ckpt - eps);
+        let due = (
+            t >= sched.frame - eps,
+            t >= sched.diag - eps,
+            t >= sched.ckpt - eps,
+        );
         if trip.is_some() || !(due.0 || due.1 || due.2) {
             continue;
         }

@@ -276,6 +276,19 @@ pub enum CheckKind {
     TwoLayer,
 }
 
+impl CheckKind {
+    /// The name as written in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            CheckKind::Hydrostatic => "hydrostatic",
+            CheckKind::Poiseuille => "poiseuille",
+            CheckKind::Couette => "couette",
+            CheckKind::DamBreakFront => "dam_break_front",
+            CheckKind::TwoLayer => "two_layer",
+        }
+    }
+}
+
 /// Read a scenario file, apply `--set` overrides and parse it strictly.
 pub fn load(path: &str, overrides: &[String]) -> Result<(SceneFile, String), InputError> {
     let text = std::fs::read_to_string(path)

@@ -43,7 +43,10 @@ pub fn check_sim(m: &Model, sim: &Sim) -> Option<Trip> {
     } else if dt <= 0.0 {
         "time step is not positive".to_string()
     } else if dt < floor {
-        format!("time step collapsed below {floor:e} s ({} of the initial limit)", m.watchdog.min_dt_ratio)
+        format!(
+            "time step collapsed below {floor:e} s ({} of the initial limit)",
+            m.watchdog.min_dt_ratio
+        )
     } else {
         return None;
     };
@@ -140,9 +143,16 @@ fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
             let limit = if open { span } else { depth };
             if beyond > limit {
                 let what = if open {
-                    format!("left the domain through its open {} side", crate::scene::SIDE_NAMES[a][side])
+                    format!(
+                        "left the domain through its open {} side",
+                        crate::scene::SIDE_NAMES[a][side]
+                    )
                 } else {
-                    format!("penetrated the {} wall by {:.2} dx", crate::scene::SIDE_NAMES[a][side], beyond / m.dx)
+                    format!(
+                        "penetrated the {} wall by {:.2} dx",
+                        crate::scene::SIDE_NAMES[a][side],
+                        beyond / m.dx
+                    )
                 };
                 return Some((AXES[a], x, what));
             }

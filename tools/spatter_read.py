@@ -23,6 +23,8 @@ from pathlib import Path
 import numpy as np
 from mcap.decoder import DecoderFactory as McapDecoderFactory
 from mcap.reader import NonSeekingReader, make_reader
+from mcap.records import Metadata as MetadataRecord
+from mcap.stream_reader import StreamReader
 from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoderFactory
 
 # foxglove.PackedElementField.NumericType -> numpy little-endian type
@@ -71,7 +73,8 @@ def _messages(path):
             return
         reader = NonSeekingReader(f, validate_crcs=False, decoder_factories=DECODERS)
         try:
-            yield from reader.iter_decoded_messages()
+            # File order: sorting by time would read to the (missing) end first.
+            yield from reader.iter_decoded_messages(log_time_order=False)
         except Exception as e:  # the truncated tail; everything before it is intact
             print(f"{path}: unfinished file, read up to its last complete chunk ({e})", file=sys.stderr)
 
@@ -86,11 +89,22 @@ def read_mcap(path):
         elif channel.topic == "/diagnostics":
             diagnostics.append(decoded)
     info["complete"] = is_complete(path)
-    if info["complete"]:
-        with open(path, "rb") as f:
-            for record in make_reader(f).iter_metadata():
-                info["metadata"][record.name] = dict(record.metadata)
+    info["metadata"] = read_metadata(path)
     return frames, diagnostics, info
+
+
+def read_metadata(path):
+    """{name: {key: value}} of the file's metadata records (the run's scenario,
+    version and backend live in the one named "spatter")."""
+    out = {}
+    with open(path, "rb") as f:
+        try:
+            for record in StreamReader(f).records:
+                if isinstance(record, MetadataRecord):
+                    out[record.name] = dict(record.metadata)
+        except Exception:  # unfinished file: the records before the cut are enough
+            pass
+    return out
 
 
 def read_vtu(path):

@@ -12,6 +12,20 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq mesa-vulkan-drivers >/dev/null
 fi
 
+# The Python reader (tools/spatter_read.py) is tested on files the simulator writes;
+# its packages live in .venv (tools/requirements.txt).
+if ! .venv/bin/python -c "import mcap, mcap_protobuf, numpy, matplotlib" >/dev/null 2>&1; then
+    echo "setting up the Python reader's environment (.venv from tools/requirements.txt)"
+    if ! python3 -m venv .venv >/dev/null 2>&1; then
+        SUDO=""
+        if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+        $SUDO apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq python3-venv >/dev/null
+        python3 -m venv .venv
+    fi
+    .venv/bin/pip install -q --disable-pip-version-check -r tools/requirements.txt
+fi
+
 # Any writable folder keeps the Vulkan loader quiet.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo test --release --locked "$@"

@@ -38,6 +38,12 @@ pub struct Provenance<'a> {
 impl McapSink {
     pub fn create(path: &str, m: &Model, prov: &Provenance) -> Result<McapSink, String> {
         let err = |e: &dyn std::fmt::Display| format!("{path}: cannot write MCAP: {e}");
+        if let Some(dir) = std::path::Path::new(path)
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+        {
+            std::fs::create_dir_all(dir).map_err(|e| err(&e))?;
+        }
         let file = File::create(path).map_err(|e| err(&e))?;
         let mut w = WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
@@ -67,7 +73,10 @@ impl McapSink {
             .add_channel(diag_schema, DIAGNOSTICS_TOPIC, "json", &none)
             .map_err(|e| err(&e))?;
         let meta = BTreeMap::from([
-            ("spatter_version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
+            (
+                "spatter_version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
             ("backend".to_string(), prov.backend.to_string()),
             ("command".to_string(), prov.command.to_string()),
             ("scenario_file".to_string(), m.file.clone()),

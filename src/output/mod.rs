@@ -132,7 +132,11 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
 /// JSON schema of a `/diagnostics` message (Foxglove's plot panel reads the numbers).
 pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
     let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
-    let per_depth = if m.dim == 2 { " per metre of depth" } else { "" };
+    let per_depth = if m.dim == 2 {
+        " per metre of depth"
+    } else {
+        ""
+    };
     let phases: serde_json::Map<String, serde_json::Value> = m
         .phases
         .iter()

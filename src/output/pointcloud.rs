@@ -94,8 +94,17 @@ pub fn encode_frame(time: f64, fields: &[Field]) -> Vec<u8> {
         }),
         frame_id: "world".into(),
         pose: Some(Pose {
-            position: Some(Vector3 { x: 0.0, y: 0.0, z: 0.0 }),
-            orientation: Some(Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 }),
+            position: Some(Vector3 {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+            orientation: Some(Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 1.0,
+            }),
         }),
         point_stride: stride as u32,
         fields: fields
@@ -115,11 +124,21 @@ pub fn encode_frame(time: f64, fields: &[Field]) -> Vec<u8> {
     msg.encode_to_vec()
 }
 
-fn field(name: &str, number: i32, ty: Type, type_name: Option<&str>, repeated: bool) -> FieldDescriptorProto {
+fn field(
+    name: &str,
+    number: i32,
+    ty: Type,
+    type_name: Option<&str>,
+    repeated: bool,
+) -> FieldDescriptorProto {
     FieldDescriptorProto {
         name: Some(name.into()),
         number: Some(number),
-        label: Some(if repeated { Label::Repeated } else { Label::Optional } as i32),
+        label: Some(if repeated {
+            Label::Repeated
+        } else {
+            Label::Optional
+        } as i32),
         r#type: Some(ty as i32),
         type_name: type_name.map(str::to_string),
         json_name: Some(name.into()),
@@ -135,7 +154,12 @@ fn message(name: &str, fields: Vec<FieldDescriptorProto>) -> DescriptorProto {
     }
 }
 
-fn file(name: &str, package: &str, deps: &[&str], messages: Vec<DescriptorProto>) -> FileDescriptorProto {
+fn file(
+    name: &str,
+    package: &str,
+    deps: &[&str],
+    messages: Vec<DescriptorProto>,
+) -> FileDescriptorProto {
     FileDescriptorProto {
         name: Some(name.into()),
         package: Some(package.into()),
@@ -157,7 +181,13 @@ pub fn schema_descriptor_set() -> Vec<u8> {
         vec![
             field("name", 1, String, None, false),
             field("offset", 2, Fixed32, None, false),
-            field("type", 3, Enum, Some(".foxglove.PackedElementField.NumericType"), false),
+            field(
+                "type",
+                3,
+                Enum,
+                Some(".foxglove.PackedElementField.NumericType"),
+                false,
+            ),
         ],
     );
     packed.enum_type.push(EnumDescriptorProto {
@@ -187,10 +217,18 @@ pub fn schema_descriptor_set() -> Vec<u8> {
             &[],
             vec![message(
                 "Timestamp",
-                vec![field("seconds", 1, Int64, None, false), field("nanos", 2, Int32, None, false)],
+                vec![
+                    field("seconds", 1, Int64, None, false),
+                    field("nanos", 2, Int32, None, false),
+                ],
             )],
         ),
-        file("foxglove/Vector3.proto", "foxglove", &[], vec![message("Vector3", xyz(&["x", "y", "z"]))]),
+        file(
+            "foxglove/Vector3.proto",
+            "foxglove",
+            &[],
+            vec![message("Vector3", xyz(&["x", "y", "z"]))],
+        ),
         file(
             "foxglove/Quaternion.proto",
             "foxglove",
@@ -205,11 +243,22 @@ pub fn schema_descriptor_set() -> Vec<u8> {
                 "Pose",
                 vec![
                     field("position", 1, Message, Some(".foxglove.Vector3"), false),
-                    field("orientation", 2, Message, Some(".foxglove.Quaternion"), false),
+                    field(
+                        "orientation",
+                        2,
+                        Message,
+                        Some(".foxglove.Quaternion"),
+                        false,
+                    ),
                 ],
             )],
         ),
-        file("foxglove/PackedElementField.proto", "foxglove", &[], vec![packed]),
+        file(
+            "foxglove/PackedElementField.proto",
+            "foxglove",
+            &[],
+            vec![packed],
+        ),
         file(
             "foxglove/PointCloud.proto",
             "foxglove",
@@ -221,11 +270,23 @@ pub fn schema_descriptor_set() -> Vec<u8> {
             vec![message(
                 "PointCloud",
                 vec![
-                    field("timestamp", 1, Message, Some(".google.protobuf.Timestamp"), false),
+                    field(
+                        "timestamp",
+                        1,
+                        Message,
+                        Some(".google.protobuf.Timestamp"),
+                        false,
+                    ),
                     field("frame_id", 2, String, None, false),
                     field("pose", 3, Message, Some(".foxglove.Pose"), false),
                     field("point_stride", 4, Fixed32, None, false),
-                    field("fields", 5, Message, Some(".foxglove.PackedElementField"), true),
+                    field(
+                        "fields",
+                        5,
+                        Message,
+                        Some(".foxglove.PackedElementField"),
+                        true,
+                    ),
                     field("data", 6, Bytes, None, false),
                 ],
             )],
@@ -241,8 +302,14 @@ mod tests {
     #[test]
     fn frame_round_trips_through_prost() {
         let fields = vec![
-            Field { name: "x", values: Values::F32(vec![1.5, -2.0]) },
-            Field { name: "id", values: Values::U32(vec![7, 9]) },
+            Field {
+                name: "x",
+                values: Values::F32(vec![1.5, -2.0]),
+            },
+            Field {
+                name: "id",
+                values: Values::U32(vec![7, 9]),
+            },
         ];
         let bytes = encode_frame(1.25, &fields);
         let msg = PointCloud::decode(bytes.as_slice()).unwrap();

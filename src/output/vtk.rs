@@ -20,7 +20,8 @@ pub struct VtkSink {
 
 impl VtkSink {
     pub fn create(dir: &str) -> Result<VtkSink, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{dir}: cannot create VTK folder: {e}"))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{dir}: cannot create VTK folder: {e}"))?;
         Ok(VtkSink {
             dir: PathBuf::from(dir),
             frames: Vec::new(),
@@ -37,7 +38,10 @@ impl VtkSink {
         write_atomic(&self.dir.join(&name), &bytes)?;
         self.frames.push((st.sim.time as f64, name));
         self.last_frame_step = Some(st.sim.step);
-        write_atomic(&self.dir.join(COLLECTION), pvd_text(&self.frames).as_bytes())
+        write_atomic(
+            &self.dir.join(COLLECTION),
+            pvd_text(&self.frames).as_bytes(),
+        )
     }
 }
 
@@ -53,7 +57,10 @@ fn pvd_text(frames: &[(f64, String)]) -> String {
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <Collection>\n",
     );
     for (t, name) in frames {
-        let _ = writeln!(s, "    <DataSet timestep=\"{t:e}\" part=\"0\" file=\"{name}\"/>");
+        let _ = writeln!(
+            s,
+            "    <DataSet timestep=\"{t:e}\" part=\"0\" file=\"{name}\"/>"
+        );
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     s
@@ -73,7 +80,8 @@ impl Appended {
             "        <DataArray type=\"{vtk_type}\"{name} NumberOfComponents=\"{components}\" format=\"appended\" offset=\"{}\"/>",
             self.data.len()
         );
-        self.data.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+        self.data
+            .extend_from_slice(&(bytes.len() as u64).to_le_bytes());
         self.data.extend_from_slice(bytes);
     }
 }
@@ -95,13 +103,24 @@ fn interleave3(a: &Values, b: &Values, c: &Values) -> Vec<u8> {
 /// The whole `.vtu` file for one frame: x/y/z become the points, vx/vy/vz the
 /// `velocity` vector, every other field a scalar array; each particle a vertex cell.
 pub fn vtu_bytes(fields: &[Field]) -> Vec<u8> {
-    let get = |n: &str| &fields.iter().find(|f| f.name == n).expect("position/velocity fields").values;
+    let get = |n: &str| {
+        &fields
+            .iter()
+            .find(|f| f.name == n)
+            .expect("position/velocity fields")
+            .values
+    };
     let n = get("x").len();
     let mut point_data = Appended {
         data: Vec::new(),
         xml: String::new(),
     };
-    point_data.array("Float32", Some("velocity"), 3, &interleave3(get("vx"), get("vy"), get("vz")));
+    point_data.array(
+        "Float32",
+        Some("velocity"),
+        3,
+        &interleave3(get("vx"), get("vy"), get("vz")),
+    );
     for f in fields {
         if ["x", "y", "z", "vx", "vy", "vz"].contains(&f.name) {
             continue;
@@ -110,7 +129,12 @@ pub fn vtu_bytes(fields: &[Field]) -> Vec<u8> {
         point_data.array(ty, Some(f.name), 1, &bytes);
     }
     let pd_xml = std::mem::take(&mut point_data.xml);
-    point_data.array("Float32", None, 3, &interleave3(get("x"), get("y"), get("z")));
+    point_data.array(
+        "Float32",
+        None,
+        3,
+        &interleave3(get("x"), get("y"), get("z")),
+    );
     let points_xml = std::mem::take(&mut point_data.xml);
     let idx: Vec<u8> = (0..n as i64).flat_map(|i| i.to_le_bytes()).collect();
     let offsets: Vec<u8> = (1..=n as i64).flat_map(|i| i.to_le_bytes()).collect();

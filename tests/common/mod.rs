@@ -26,3 +26,36 @@ pub fn scene(name: &str) -> String {
         env!("CARGO_MANIFEST_DIR")
     )
 }
+
+/// The Python with tools/requirements.txt installed: $SPATTER_PYTHON, else the
+/// repository's .venv that tools/test.sh sets up.
+pub fn python() -> std::path::PathBuf {
+    if let Ok(p) = std::env::var("SPATTER_PYTHON") {
+        return p.into();
+    }
+    let venv = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    assert!(
+        venv.exists(),
+        "no Python environment for tools/spatter_read.py: run tools/test.sh, or \
+         python3 -m venv .venv && .venv/bin/pip install -r tools/requirements.txt"
+    );
+    venv
+}
+
+/// Run tools/spatter_read.py with `args`.
+pub fn reader(args: &[&str]) -> Output {
+    let script = format!("{}/tools/spatter_read.py", env!("CARGO_MANIFEST_DIR"));
+    Command::new(python())
+        .arg(script)
+        .args(args)
+        .output()
+        .expect("run tools/spatter_read.py")
+}
+
+/// A fresh, empty scratch folder for one test.
+pub fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}

@@ -89,7 +89,11 @@ impl Backend for CpuBackend {
         self.st.sim
     }
     fn load_state(&mut self, st: &State) {
-        assert_eq!(st.len(), self.st.len(), "load_state: particle count changed");
+        assert_eq!(
+            st.len(),
+            self.st.len(),
+            "load_state: particle count changed"
+        );
         self.st = st.clone();
     }
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {

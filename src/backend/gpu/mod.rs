@@ -596,7 +596,11 @@ impl Backend for GpuBackend {
         }
     }
     fn load_state(&mut self, st: &State) {
-        assert_eq!(st.len() as u32, self.params.counts[0], "load_state: particle count changed");
+        assert_eq!(
+            st.len() as u32,
+            self.params.counts[0],
+            "load_state: particle count changed"
+        );
         self.upload(st);
     }
     fn read_sim(&mut self) -> Sim {

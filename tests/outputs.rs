@@ -1,0 +1,356 @@
+//! Run outputs (issue 3): MCAP and VTK decoded by the Python reader, endings by
+//! signal and by instability, checkpoint/resume bit-identity, `spatter inspect`.
+
+mod common;
+use common::{reader, scratch, spatter, text};
+use spatter::checkpoint;
+use spatter::output::{particle_fields, Values};
+use spatter::state::State;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn summary(mcap: &Path) -> serde_json::Value {
+    let out = reader(&["summary", s(mcap)]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    serde_json::from_str(&stdout).expect("summary JSON")
+}
+
+/// The newest checkpoint in a folder.
+fn newest_checkpoint(dir: &Path) -> checkpoint::Checkpoint {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .expect("checkpoint folder")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ckpt"))
+        .collect();
+    files.sort();
+    let last = files.last().expect("a checkpoint");
+    checkpoint::load(s(last)).expect("checkpoint loads")
+}
+
+#[test]
+fn dam_break_3d_mcap_and_vtk_decode_in_python() {
+    let dir = scratch("outputs_dam_break_3d");
+    let (mcap, vtk, ck) = (dir.join("d.mcap"), dir.join("vtk"), dir.join("ck"));
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_3d"),
+        "--backend",
+        "cpu",
+        "--steps",
+        "300",
+        "--out",
+        s(&mcap),
+        "--vtk",
+        s(&vtk),
+        "--checkpoint-every",
+        "1e9",
+        "--checkpoint-dir",
+        s(&ck),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+
+    // Every frame decodes with the foxglove.PointCloud schema, every diagnostics
+    // message with its JSON schema; particle counts match the scene.
+    let sum = summary(&mcap);
+    let frames = sum["frames"].as_u64().unwrap();
+    assert!(frames >= 8, "{sum}");
+    assert_eq!(
+        sum["particles_per_frame"],
+        serde_json::json!([15296]),
+        "{sum}"
+    );
+    assert_eq!(sum["diagnostics"].as_u64(), Some(frames), "{sum}");
+    assert_eq!(sum["schemas"]["/particles"], "foxglove.PointCloud");
+    assert_eq!(sum["schemas"]["/diagnostics"], "spatter.Diagnostics");
+    assert_eq!(sum["complete"], true);
+    assert_eq!(sum["has_scenario"], true);
+    let last = &sum["last_diagnostics"];
+    assert_eq!(last["step"], 300);
+    assert_eq!(last["particles"]["water"], 2000);
+    // Fluid mass is conserved exactly: 2000 particles of ρ0 Δx³ = 1e-3 kg.
+    assert!(
+        (last["total_mass"].as_f64().unwrap() - 2.0).abs() < 1e-5,
+        "{last}"
+    );
+
+    // The last frame equals the last .vtu, field by field.
+    let cmp = reader(&["compare-vtk", s(&mcap), s(&vtk)]);
+    let (o, e) = text(&cmp);
+    assert_eq!(cmp.status.code(), Some(0), "{o}{e}");
+    let pvd = std::fs::read_to_string(vtk.join("particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count() as u64, frames, "{pvd}");
+
+    // The decoded arrays equal the simulator's own final state (its checkpoint).
+    let export = dir.join("last");
+    let ex = reader(&["export-last", s(&mcap), s(&export)]);
+    assert_eq!(ex.status.code(), Some(0), "{:?}", text(&ex));
+    let ckpt = newest_checkpoint(&ck);
+    assert_eq!(ckpt.state.sim.step, 300);
+    let loaded = spatter::run::load(&common::scene("dam_break_3d"), &[]).unwrap();
+    for f in particle_fields(&loaded.model, &ckpt.state) {
+        let (suffix, expected): (&str, Vec<u8>) = match &f.values {
+            Values::F32(v) => ("f32", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+            Values::U32(v) => ("u32", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+        };
+        let got = std::fs::read(export.join(format!("{}.{suffix}", f.name))).unwrap();
+        assert!(
+            got == expected,
+            "field {} differs between MCAP and the final state",
+            f.name
+        );
+    }
+
+    // Diagnostics plot to PNG.
+    let png = dir.join("diagnostics.png");
+    let pl = reader(&["plot", s(&mcap), s(&png)]);
+    assert_eq!(pl.status.code(), Some(0), "{:?}", text(&pl));
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+
+    // inspect names channels, schemas and counts.
+    let ins = spatter(&["inspect", s(&mcap)]);
+    let (o, _) = text(&ins);
+    assert_eq!(ins.status.code(), Some(0), "{o}");
+    assert!(o.contains("complete: yes"), "{o}");
+    assert!(
+        o.contains(&format!(
+            "/particles: schema foxglove.PointCloud (protobuf), {frames} messages"
+        )),
+        "{o}"
+    );
+    assert!(o.contains("15296 particles per frame"), "{o}");
+    assert!(
+        o.contains("/diagnostics: schema spatter.Diagnostics (jsonschema)"),
+        "{o}"
+    );
+    assert!(
+        o.contains("kind = \"dam_break_front\""),
+        "stored scenario: {o}"
+    );
+}
+
+/// Start a long CPU run writing MCAP and VTK; return once three frames are on disk.
+fn start_long_run(dir: &Path) -> std::process::Child {
+    let xdg = std::env::temp_dir().join("spatter-xdg");
+    let _ = std::fs::create_dir_all(&xdg);
+    let child = Command::new(env!("CARGO_BIN_EXE_spatter"))
+        .args(["run", &common::scene("dam_break_3d"), "--backend", "cpu"])
+        .args([
+            "--out",
+            s(&dir.join("run.mcap")),
+            "--vtk",
+            s(&dir.join("vtk")),
+        ])
+        .env("XDG_RUNTIME_DIR", xdg)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start spatter");
+    // The VTK frame is written after the MCAP frame of the same step, so once
+    // frame 2 exists the MCAP holds three flushed frames.
+    let third = dir.join("vtk/frame_000002.vtu");
+    let t0 = std::time::Instant::now();
+    while !third.exists() {
+        assert!(t0.elapsed().as_secs() < 300, "run produced no third frame");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child
+}
+
+fn signal(child: &std::process::Child, sig: &str) {
+    let st = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+}
+
+#[test]
+fn sigint_half_way_leaves_a_finished_mcap() {
+    let dir = scratch("outputs_sigint");
+    let child = start_long_run(&dir);
+    signal(&child, "-INT");
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(130), "{stdout}{stderr}");
+    assert!(stderr.contains("interrupted by a signal"), "{stderr}");
+    let sum = summary(&dir.join("run.mcap"));
+    assert_eq!(sum["complete"], true, "{sum}");
+    assert!(
+        sum["frames"].as_u64().unwrap() >= 4,
+        "3 frames + the last: {sum}"
+    );
+    // The interrupted run leaves a checkpoint of where it stopped.
+    let ck = newest_checkpoint(&dir.join("run.checkpoints"));
+    assert!(
+        stdout.contains(&format!("step_{:010}.ckpt", ck.state.sim.step)),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn hard_kill_leaves_mcap_readable_to_its_last_chunk() {
+    let dir = scratch("outputs_sigkill");
+    let mut child = start_long_run(&dir);
+    signal(&child, "-KILL");
+    child.wait().unwrap();
+    let mcap = dir.join("run.mcap");
+    let sum = summary(&mcap);
+    assert_eq!(sum["complete"], false, "{sum}");
+    assert!(sum["frames"].as_u64().unwrap() >= 3, "{sum}");
+    assert_eq!(
+        sum["particles_per_frame"],
+        serde_json::json!([15296]),
+        "{sum}"
+    );
+    assert_eq!(sum["has_scenario"], true, "{sum}");
+    let ins = spatter(&["inspect", s(&mcap)]);
+    let (o, e) = text(&ins);
+    assert_eq!(ins.status.code(), Some(0), "{o}{e}");
+    assert!(o.contains("complete: no"), "{o}");
+}
+
+/// 200 steps straight against 100 + resume 100: the final states are identical.
+fn resume_is_bit_identical(backend: &str) {
+    let dir = scratch(&format!("outputs_resume_{backend}"));
+    let sc = common::scene("dam_break_2d");
+    let ck = |name: &str| dir.join(name);
+    let run = |extra: &[&str], ckdir: &Path| {
+        let mut args = vec!["run", "--backend", backend, "--steps"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--checkpoint-every", "1e9", "--checkpoint-dir", s(ckdir)]);
+        let out = spatter(&args);
+        assert_eq!(out.status.code(), Some(0), "{:?}", text(&out));
+    };
+    run(&["200", &sc], &ck("straight"));
+    run(&["100", &sc], &ck("first"));
+    let half = dir.join("first/step_0000000100.ckpt");
+    run(&["100", "--resume", s(&half)], &ck("resumed"));
+    let a: State = newest_checkpoint(&ck("straight")).state;
+    let b: State = newest_checkpoint(&ck("resumed")).state;
+    assert_eq!(a.sim.step, 200);
+    assert_eq!(b.sim.step, 200);
+    for (fa, fb) in a.fields().iter().zip(b.fields().iter()) {
+        assert!(
+            fa.words == fb.words,
+            "{backend}: field {} differs after resume",
+            fa.name
+        );
+    }
+    assert_eq!(a.sim, b.sim);
+}
+
+#[test]
+fn resume_is_bit_identical_on_cpu() {
+    resume_is_bit_identical("cpu");
+}
+
+#[test]
+fn resume_is_bit_identical_on_the_software_adapter() {
+    resume_is_bit_identical("gpu");
+}
+
+#[test]
+fn unstable_run_stops_with_exit_3_and_a_readable_mcap() {
+    let dir = scratch("outputs_unstable");
+    let mcap = dir.join("u.mcap");
+    // Fixed Δt ten times the acoustic limit (0.25 h/c = 3.125e-5 s), check disabled.
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_2d"),
+        "--backend",
+        "cpu",
+        "--set",
+        "dt=3.125e-4",
+        "--set",
+        "dt_check=false",
+        "--out",
+        s(&mcap),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
+    let msg = stderr
+        .lines()
+        .find(|l| l.contains("unstable at step"))
+        .expect("diagnosis");
+    assert!(msg.contains("particle ") && msg.contains("field "), "{msg}");
+    let step: u64 = msg
+        .split("unstable at step ")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let sum = summary(&mcap);
+    assert_eq!(sum["complete"], true, "{sum}");
+    // The last frame is the failing step; the checkpoint the step before it.
+    assert_eq!(
+        sum["last_diagnostics"]["step"].as_u64(),
+        Some(step),
+        "{sum}"
+    );
+    let ck = newest_checkpoint(&dir.join("u.checkpoints"));
+    assert_eq!(ck.state.sim.step as u64 + 1, step);
+    assert!(spatter::watchdog::scan(
+        &spatter::run::load(
+            &common::scene("dam_break_2d"),
+            &["dt=3.125e-4".into(), "dt_check=false".into()]
+        )
+        .unwrap()
+        .model,
+        &ck.state
+    )
+    .is_none());
+    let ins = spatter(&["inspect", s(&mcap)]);
+    assert_eq!(ins.status.code(), Some(0));
+}
+
+#[test]
+fn a_fixed_dt_above_the_limit_is_refused_unless_the_check_is_off() {
+    let out = spatter(&[
+        "validate",
+        &common::scene("dam_break_2d"),
+        "--set",
+        "dt=3.125e-4",
+    ]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("run.dt") && stderr.contains("stability limit"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn checkpoint_every_without_a_folder_is_an_input_error() {
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_2d"),
+        "--checkpoint-every",
+        "0.01",
+    ]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--checkpoint-every"), "{stderr}");
+}
+
+#[test]
+fn a_damaged_checkpoint_is_refused_with_its_name() {
+    let dir = scratch("outputs_bad_checkpoint");
+    let bad = dir.join("bad.ckpt");
+    std::fs::write(&bad, b"SPATCKPT not really a checkpoint").unwrap();
+    let out = spatter(&["run", "--resume", s(&bad)]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("bad.ckpt") && stderr.contains("checkpoint"),
+        "{stderr}"
+    );
+}

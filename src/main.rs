@@ -205,6 +205,12 @@ fn cmd_run(
             .into());
         }
     }
+    if let Some(dt) = loaded.model.fixed_dt {
+        let (lim, which) = loaded.model.limits.min();
+        if dt > lim {
+            eprintln!("warning: fixed dt {dt:e} s exceeds the stability limit {lim:e} s ({which}); run.dt_check = false lets it through");
+        }
+    }
     let mut backend = run::make_backend(choice, &loaded, profile)?;
     let backend_name = backend.describe();
     let mut outputs = open_outputs(out_args, &loaded, &backend_name)?;

@@ -160,3 +160,69 @@ fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> (Model, State) {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/dam_break_2d.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        (l.model, l.state)
+    }
+
+    fn fluid(m: &Model, st: &State) -> Vec<usize> {
+        (0..st.len())
+            .filter(|&i| m.phases[st.phase[i] as usize].kind != PhaseKind::Wall)
+            .collect()
+    }
+
+    #[test]
+    fn initial_state_is_sane() {
+        let (m, mut st) = scene();
+        st.rho.iter_mut().for_each(|r| *r = 1000.0);
+        assert_eq!(scan(&m, &st), None);
+    }
+
+    #[test]
+    fn names_the_lowest_id_with_a_non_finite_value() {
+        let (m, mut st) = scene();
+        st.rho.iter_mut().for_each(|r| *r = 1000.0);
+        let f = fluid(&m, &st);
+        st.vel[f[7]][1] = f32::NAN;
+        st.p[f[3]] = f32::INFINITY;
+        let t = scan(&m, &st).expect("trip");
+        assert_eq!(t.particle, Some(st.id[f[3]].min(st.id[f[7]])));
+        assert!(t.reason.contains("not finite"));
+    }
+
+    #[test]
+    fn catches_wall_penetration_and_density_outside_the_band() {
+        let (m, mut st) = scene();
+        st.rho.iter_mut().for_each(|r| *r = 1000.0);
+        let f = fluid(&m, &st);
+        st.pos[f[0]][0] = (m.domain_lo[0] - m.origin[0] - 0.6 * m.dx) as f32;
+        let t = scan(&m, &st).expect("penetration");
+        assert_eq!((t.field.as_str(), t.particle), ("x", Some(st.id[f[0]])));
+        assert!(t.reason.contains("x_min wall"), "{}", t.reason);
+        st.pos[f[0]][0] = (m.domain_lo[0] - m.origin[0] + 0.5 * m.dx) as f32;
+        st.rho[f[1]] = 5000.0;
+        let t = scan(&m, &st).expect("density");
+        assert_eq!(t.field, "density");
+    }
+
+    #[test]
+    fn dt_collapse_and_nan_dt_trip() {
+        let (m, st) = scene();
+        let mut sim = st.sim;
+        sim.dt = (m.limits.min().0 * 1e-4) as f32;
+        assert!(check_sim(&m, &sim).unwrap().reason.contains("collapsed"));
+        sim.dt = f32::NAN;
+        assert!(check_sim(&m, &sim).is_some());
+        sim.dt = m.limits.min().0 as f32;
+        assert!(check_sim(&m, &sim).is_none());
+    }
+}

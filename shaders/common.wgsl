@@ -14,6 +14,9 @@ struct Params {
     dtp: vec4<f32>,          // h, c_max, viscous limit, fixed dt
     phase_a: array<vec4<f32>, 8>, // rho0, c², eta, kind
     phase_b: array<vec4<f32>, 8>, // wall velocity, slip
+    phase_c: array<vec4<f32>, 8>, // heat: k, c_p, h_solidus, h_liquidus
+    phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
+    heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
     consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
 }
 
@@ -30,6 +33,9 @@ struct Sim {
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
 const KIND_WALL: f32 = 2.0;
+const HEAT_DIRICHLET: u32 = 1u;
+const HEAT_MELTS: u32 = 2u;
+const HEAT_LIQUID: u32 = 4u;
 const WG: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -54,14 +60,28 @@ const WG: u32 = 64u;
 @group(0) @binding(19) var<storage, read_write> s_pid: array<u32>;
 @group(0) @binding(20) var<storage, read_write> sim: Sim;
 @group(0) @binding(21) var<storage, read_write> partials: array<vec2<f32>>;
+// Heat scenes: (h, T, f_l, dh/dt) and its reorder scratch; a 16-byte placeholder
+// otherwise (no heat pass is dispatched).
+@group(0) @binding(22) var<storage, read_write> heat: array<vec4<f32>>;
+@group(0) @binding(23) var<storage, read_write> s_heat: array<vec4<f32>>;
 
 // Linear thread index for 1D work split over a 2D dispatch grid (65535-group limit).
 fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
 }
 
+// Wall or solid: does not move, is a wall for the fluid passes.
 fn is_wall(ph: u32) -> bool {
-    return P.phase_a[ph].w == KIND_WALL;
+    return P.phase_a[ph].w >= KIND_WALL;
+}
+
+// Carries an evolving temperature: liquid, gas or solid in a heat scene.
+fn conducts(ph: u32) -> bool {
+    return P.heat.z != 0.0 && P.phase_a[ph].w != KIND_WALL;
+}
+
+fn heat_flags(ph: u32) -> u32 {
+    return u32(P.phase_d[ph].w);
 }
 
 // Arithmetic literals come from the uniform block, never from the source:
@@ -81,6 +101,7 @@ fn c_seventy_five() -> f32 { return P.consts[2].y; }
 fn c_one_and_half() -> f32 { return P.consts[2].z; }
 fn c_three_quarters() -> f32 { return P.consts[2].w; }
 fn c_nine_quarters() -> f32 { return P.consts[3].x; }
+fn c_four() -> f32 { return P.consts[6].w; }
 
 fn p4(t: f32) -> f32 { return t * t * t * t; }
 fn p5(t: f32) -> f32 { return t * t * t * t * t; }

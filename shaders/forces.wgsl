@@ -33,7 +33,7 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                         let dwdr = kernel_dw(r);
                         let ph_j = phase[j];
                         let mat_j = P.phase_a[ph_j];
-                        let wall = mat_j.w == KIND_WALL;
+                        let wall = mat_j.w >= KIND_WALL;
                         let p_j = press[j];
                         var rho_j = rho[j];
                         var m_j = mass[j];

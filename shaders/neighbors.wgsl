@@ -53,6 +53,9 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     s_mass[k] = mass[s];
     s_phase[k] = phase[s];
     s_pid[k] = pid[s];
+    if (P.heat.z != 0.0) {
+        s_heat[k] = heat[s];
+    }
 }
 
 @compute @workgroup_size(64)

@@ -51,11 +51,19 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
     sim.umax2 = umax2;
     sim.amax2 = amax2;
     let h = P.dtp.x;
-    var dt = c_quarter() * h / (P.dtp.y + sqrt(umax2));
+    let speed = P.dtp.y + sqrt(umax2);
+    var dt = 3.40282347e38;
+    if (speed > 0.0) {
+        dt = c_quarter() * h / speed;
+    }
     var which = 0u;
     if (P.dtp.z < dt) {
         dt = P.dtp.z;
         which = 1u;
+    }
+    if (P.heat.x < dt) {
+        dt = P.heat.x;
+        which = 4u;
     }
     if (amax2 > 0.0) {
         let f = c_quarter() * sqrt(h / sqrt(amax2));

@@ -3,7 +3,8 @@
 //!
 //! Layout (little-endian): magic `SPATCKPT`, u32 format version, u32 reserved,
 //! u64 header length, JSON header, then the arrays in `State` order (pos, vel, acc,
-//! acc_b as 4×f32; rho, p, mass as f32; phase, id as u32), the 32-byte `Sim`
+//! acc_b as 4×f32; rho, p, mass as f32; phase, id as u32; heat as 4×f32 in heat
+//! scenes), the 32-byte `Sim`
 //! block, and a CRC-32 of everything before it. Files are written to a temporary
 //! name and renamed, so a checkpoint on disk is always complete.
 
@@ -34,6 +35,9 @@ pub struct Header {
     /// random numbers, so the seed is the whole RNG state.
     pub rng_seed: u64,
     pub rng_draws_after_setup: u64,
+    /// The heat array (h, T, f_l, dh/dt) follows `id` (heat scenes).
+    #[serde(default)]
+    pub heat: bool,
 }
 
 pub struct Checkpoint {
@@ -57,6 +61,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         dt: st.sim.dt as f64,
         rng_seed: m.seed,
         rng_draws_after_setup: 0,
+        heat: !st.heat.is_empty(),
     };
     let json = serde_json::to_vec(&header).expect("checkpoint header serializes");
     let mut out = Vec::with_capacity(64 + json.len() + st.len() * 100);
@@ -74,6 +79,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
     for v in [&st.phase, &st.id] {
         push(&mut out, v);
     }
+    push(&mut out, &st.heat);
     out.extend_from_slice(bytemuck::bytes_of(&st.sim));
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -143,6 +149,7 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         mass: c.vec(n).ok_or_else(short)?,
         phase: c.vec(n).ok_or_else(short)?,
         id: c.vec(n).ok_or_else(short)?,
+        heat: c.vec(if header.heat { n } else { 0 }).ok_or_else(short)?,
         sim: bytemuck::pod_read_unaligned::<Sim>(
             c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?,
         ),

@@ -6,6 +6,9 @@ use crate::scene::{CheckKind, PhaseKind};
 use crate::state::State;
 use std::f64::consts::PI;
 
+#[path = "heat_checks.rs"]
+mod heat_checks;
+
 pub struct CheckResult {
     pub name: String,
     pub metric: String,
@@ -72,6 +75,8 @@ pub struct Checker {
     tolerance: f64,
     samples: Vec<(f64, f64)>,
     max_penetration: f64,
+    /// Total enthalpy at the first sample (adiabatic check).
+    initial_enthalpy: Option<f64>,
 }
 
 impl Checker {
@@ -81,6 +86,7 @@ impl Checker {
             tolerance: c.tolerance,
             samples: Vec::new(),
             max_penetration: 0.0,
+            initial_enthalpy: None,
         })
     }
 
@@ -97,6 +103,10 @@ impl Checker {
             CheckKind::TwoLayer => {
                 let (top_liq, bottom_gas) = layer_extent(m, st);
                 self.max_penetration = self.max_penetration.max(top_liq - bottom_gas);
+            }
+            CheckKind::Adiabatic => {
+                self.initial_enthalpy
+                    .get_or_insert(heat_checks::total_enthalpy(m, st));
             }
             _ => {}
         }
@@ -116,6 +126,13 @@ impl Checker {
             CheckKind::Couette => profile_error(m, st, Profile::Couette),
             CheckKind::DamBreakFront => self.dam_break(m, c.column_width.unwrap_or(f64::NAN)),
             CheckKind::TwoLayer => self.two_layer(m, st),
+            CheckKind::Conduction1d => heat_checks::conduction_1d(m, st),
+            CheckKind::ConductionTwoMaterials => {
+                heat_checks::two_materials(m, st, c.surface.unwrap_or(f64::NAN))
+            }
+            CheckKind::Adiabatic => {
+                heat_checks::adiabatic(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
+            }
         };
         let pass = value.is_finite() && value <= self.tolerance;
         CheckResult {
@@ -216,7 +233,7 @@ fn layer_extent(m: &Model, st: &State) -> (f64, f64) {
         match p.kind {
             PhaseKind::Liquid => top_liq = top_liq.max(p.x[ax]),
             PhaseKind::Gas => bottom_gas = bottom_gas.min(p.x[ax]),
-            PhaseKind::Wall => {}
+            PhaseKind::Wall | PhaseKind::Solid => {}
         }
     }
     (top_liq, bottom_gas)

@@ -16,11 +16,40 @@ pub struct PhaseInfo {
     pub velocity: [f64; 3],
     /// Particle mass ρ0 Δx^d (F22 Remark 2).
     pub mass: f64,
+    pub thermal: Option<Thermal>,
+}
+
+/// Heat properties of a phase (heat scenes only).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Thermal {
+    /// Initial temperature, or the fixed temperature of a Dirichlet wall (K).
+    pub temperature: f64,
+    pub conductivity: f64,
+    pub heat_capacity: f64,
+    /// (solidus, liquidus, latent heat) when the material melts.
+    pub melting: Option<(f64, f64, f64)>,
+}
+
+impl Thermal {
+    /// Specific enthalpy h(T) = c_p T + L f_l(T) (J22 (19) with the latent heat
+    /// spread linearly over the melting band).
+    pub fn enthalpy(&self, t: f64) -> f64 {
+        let base = self.heat_capacity * t;
+        match self.melting {
+            Some((ts, tl, l)) => base + l * ((t - ts) / (tl - ts)).clamp(0.0, 1.0),
+            None => base,
+        }
+    }
 }
 
 impl PhaseInfo {
+    /// Liquid or gas: moves with the flow.
     pub fn is_fluid(&self) -> bool {
-        self.kind != PhaseKind::Wall
+        matches!(self.kind, PhaseKind::Liquid | PhaseKind::Gas)
+    }
+    /// Carries a temperature that evolves (fluids and solids in heat scenes).
+    pub fn conducts(&self) -> bool {
+        self.kind != PhaseKind::Wall && self.thermal.is_some()
     }
 }
 
@@ -37,6 +66,8 @@ pub struct DtLimits {
     pub acoustic: f64,
     pub viscous: f64,
     pub body_force: f64,
+    /// 0.1 ρ c_p h²/k over conducting phases (issue 4); ∞ without heat.
+    pub conduction: f64,
 }
 
 impl DtLimits {
@@ -47,6 +78,9 @@ impl DtLimits {
         }
         if self.body_force < best.0 {
             best = (self.body_force, "body force 0.25 sqrt(h/|b|)");
+        }
+        if self.conduction < best.0 {
+            best = (self.conduction, "conduction 0.1 rho c_p h^2/k");
         }
         best
     }
@@ -103,6 +137,10 @@ impl Model {
             .filter(|p| p.is_fluid())
             .map(|p| p.viscosity / p.rho0)
             .fold(0.0, f64::max)
+    }
+    /// A heat scene: some phase carries a temperature.
+    pub fn is_thermal(&self) -> bool {
+        self.phases.iter().any(|p| p.thermal.is_some())
     }
     pub fn n_cells(&self) -> u64 {
         self.grid.iter().map(|&g| g as u64).product()
@@ -212,9 +250,17 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     check_walls(&cx, scene, &phases, dim, periodic)?;
 
     let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
-    if fluid.is_empty() {
-        return Err(cx.err("phases", "the scene has no liquid or gas phase"));
+    if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) {
+        return Err(cx.err("phases", "the scene has no liquid, gas or solid phase"));
     }
+    let conduction = phases
+        .iter()
+        .filter(|p| p.conducts())
+        .map(|p| {
+            let t = p.thermal.unwrap();
+            0.1 * p.rho0 * t.heat_capacity * h * h / t.conductivity
+        })
+        .fold(f64::INFINITY, f64::min);
     let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
     let nu_max = fluid
         .iter()
@@ -222,7 +268,11 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .fold(0.0, f64::max);
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let limits = DtLimits {
-        acoustic: 0.25 * h / c_max,
+        acoustic: if c_max > 0.0 {
+            0.25 * h / c_max
+        } else {
+            f64::INFINITY
+        },
         viscous: if nu_max > 0.0 {
             0.125 * h * h / nu_max
         } else {
@@ -233,6 +283,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         } else {
             f64::INFINITY
         },
+        conduction,
     };
 
     let run = &scene.run;
@@ -410,9 +461,80 @@ fn phase_table(
             slip: p.slip,
             velocity,
             mass: rho0 * dx.powi(dim as i32),
+            thermal: None,
         });
     }
+    thermal_table(cx, scene, &mut out)?;
     Ok(out)
+}
+
+/// Heat properties: a scene is a heat scene when any phase has a temperature.
+/// Then every non-wall phase needs a temperature, conductivity and heat capacity.
+fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Result<(), InputError> {
+    let heat_scene = scene.phases.values().any(|p| p.temperature.is_some());
+    for ph in phases.iter_mut() {
+        let def = &scene.phases[&ph.name];
+        let mat = &scene.materials[&def.material];
+        let mkey = |k: &str| format!("materials.{}.{k}", def.material);
+        let tkey = format!("phases.{}.temperature", ph.name);
+        let Some(t) = def.temperature else {
+            if heat_scene && ph.kind != PhaseKind::Wall {
+                return Err(cx.err(&tkey, "missing: a heat scene needs the initial temperature of every liquid, gas and solid phase"));
+            }
+            if ph.kind == PhaseKind::Solid {
+                return Err(cx.err(
+                    &tkey,
+                    "missing: solid phases conduct heat and need a temperature",
+                ));
+            }
+            continue;
+        };
+        cx.positive(&tkey, t)?;
+        if ph.kind == PhaseKind::Wall {
+            // A Dirichlet wall takes the conducting particle's own k (J22 (25)).
+            ph.thermal = Some(Thermal {
+                temperature: t,
+                conductivity: 0.0,
+                heat_capacity: 0.0,
+                melting: None,
+            });
+            continue;
+        }
+        let need = |k: &str, v: Option<f64>| -> Result<f64, InputError> {
+            match v {
+                Some(v) => cx.positive(&mkey(k), v),
+                None => Err(cx.err(&mkey(k), "missing: needed by a phase with a temperature")),
+            }
+        };
+        let conductivity = need("conductivity", mat.conductivity)?;
+        let heat_capacity = need("heat_capacity", mat.heat_capacity)?;
+        let melting = match (mat.solidus, mat.liquidus, mat.latent_heat) {
+            (None, None, None) => None,
+            (Some(ts), Some(tl), Some(l)) => {
+                cx.positive(&mkey("solidus"), ts)?;
+                if !(tl > ts && tl.is_finite()) {
+                    return Err(cx.err(
+                        &mkey("liquidus"),
+                        format!("must exceed the solidus {ts} K (got {tl})"),
+                    ));
+                }
+                Some((ts, tl, cx.non_negative(&mkey("latent_heat"), l)?))
+            }
+            _ => {
+                return Err(cx.err(
+                    &mkey("solidus"),
+                    "give solidus, liquidus and latent_heat together",
+                ))
+            }
+        };
+        ph.thermal = Some(Thermal {
+            temperature: t,
+            conductivity,
+            heat_capacity,
+            melting,
+        });
+    }
+    Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]

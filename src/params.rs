@@ -14,6 +14,12 @@ pub const FLAG_PRESSURE_FLOOR: u32 = 8;
 pub const KIND_LIQUID: f32 = 0.0;
 pub const KIND_GAS: f32 = 1.0;
 pub const KIND_WALL: f32 = 2.0;
+pub const KIND_SOLID: f32 = 3.0;
+
+/// `phase_d.w` flag bits (stored as an exact small integer in f32).
+pub const HEAT_DIRICHLET: u32 = 1;
+pub const HEAT_MELTS: u32 = 2;
+pub const HEAT_LIQUID: u32 = 4;
 
 /// Mirrors `struct Params` in shaders/common.wgsl field for field.
 #[repr(C)]
@@ -39,6 +45,16 @@ pub struct Params {
     pub phase_a: [[f32; 4]; MAX_PHASES],
     /// Per phase: wall velocity xyz, slip (0 no-slip, 1 free-slip).
     pub phase_b: [[f32; 4]; MAX_PHASES],
+    /// Per phase (heat): conductivity k, heat capacity c_p, enthalpy at the solidus
+    /// h_s = c_p T_s and at the liquidus h_l = c_p T_l + L.
+    pub phase_c: [[f32; 4]; MAX_PHASES],
+    /// Per phase (heat): solidus T_s, liquidus T_l, latent heat L, flags
+    /// (HEAT_DIRICHLET, HEAT_MELTS, HEAT_LIQUID). A Dirichlet wall keeps its fixed
+    /// temperature in the first slot.
+    pub phase_d: [[f32; 4]; MAX_PHASES],
+    /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
+    /// (Cleary–Monaghan regularisation), 1 for a heat scene, unused.
+    pub heat: [f32; 4],
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
@@ -57,7 +73,7 @@ pub const SHADER_CONSTS: [[f32; 4]; 8] = {
         [2.25, pm::LOG2E, pm::LN2_HI, pm::LN2_LO],
         [pm::EXP_C[0], pm::EXP_C[1], pm::EXP_C[2], pm::EXP_C[3]],
         [pm::EXP_C[4], pm::EXP_C[5], pm::LN_C[0], pm::LN_C[1]],
-        [pm::LN_C[2], pm::LN_C[3], pm::LN_C[4], 0.0],
+        [pm::LN_C[2], pm::LN_C[3], pm::LN_C[4], 4.0],
         [0.0; 4],
     ]
 };
@@ -100,6 +116,7 @@ impl Params {
                 PhaseKind::Liquid => KIND_LIQUID,
                 PhaseKind::Gas => KIND_GAS,
                 PhaseKind::Wall => KIND_WALL,
+                PhaseKind::Solid => KIND_SOLID,
             };
             let c2 = ph.sound_speed * ph.sound_speed;
             phase_a[i] = [ph.rho0 as f32, c2 as f32, ph.viscosity as f32, kind];
@@ -111,6 +128,7 @@ impl Params {
                 slip,
             ];
         }
+        let (phase_c, phase_d) = heat_tables(m);
         let viscous = if m.limits.viscous.is_finite() {
             m.limits.viscous as f32
         } else {
@@ -147,13 +165,69 @@ impl Params {
             ],
             phase_a,
             phase_b,
+            phase_c,
+            phase_d,
+            heat: [
+                finite_or_max(m.limits.conduction),
+                (0.01 * m.h * m.h) as f32,
+                if m.is_thermal() { 1.0 } else { 0.0 },
+                0.0,
+            ],
             consts: SHADER_CONSTS,
         }
     }
     pub fn n(&self) -> usize {
         self.counts[0] as usize
     }
+    /// A wall for the fluid passes: wall or solid particles (they do not move).
     pub fn is_wall(&self, phase: u32) -> bool {
-        self.phase_a[phase as usize][3] == KIND_WALL
+        self.phase_a[phase as usize][3] >= KIND_WALL
     }
+    /// Carries an evolving temperature (liquid, gas or solid in a heat scene).
+    pub fn conducts(&self, phase: u32) -> bool {
+        self.heat[2] != 0.0 && self.phase_a[phase as usize][3] != KIND_WALL
+    }
+    pub fn heat_flags(&self, phase: u32) -> u32 {
+        self.phase_d[phase as usize][3] as u32
+    }
+}
+
+fn finite_or_max(v: f64) -> f32 {
+    if v.is_finite() {
+        v as f32
+    } else {
+        f32::MAX
+    }
+}
+
+fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
+    let mut c = [[0.0f32; 4]; MAX_PHASES];
+    let mut d = [[0.0f32; 4]; MAX_PHASES];
+    for (i, ph) in m.phases.iter().enumerate() {
+        let Some(t) = ph.thermal else { continue };
+        let mut flags = 0;
+        if ph.kind == PhaseKind::Wall {
+            flags |= HEAT_DIRICHLET;
+        }
+        if ph.is_fluid() {
+            flags |= HEAT_LIQUID;
+        }
+        let (ts, tl, l) = match (ph.kind, t.melting) {
+            (PhaseKind::Wall, _) => (t.temperature, 0.0, 0.0),
+            (_, Some(m)) => m,
+            (_, None) => (0.0, 0.0, 0.0),
+        };
+        if t.melting.is_some() {
+            flags |= HEAT_MELTS;
+        }
+        let cp = t.heat_capacity;
+        c[i] = [
+            t.conductivity as f32,
+            cp as f32,
+            (cp * ts) as f32,
+            (cp * tl + l) as f32,
+        ];
+        d[i] = [ts as f32, tl as f32, l as f32, flags as f32];
+    }
+    (c, d)
 }

@@ -11,7 +11,7 @@ use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
 use crate::params::Params;
 use crate::scene;
 use crate::setup;
-use crate::state::{State, DT_LIMIT_NAMES};
+use crate::state::{dt_limit_name, State};
 use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -243,7 +243,7 @@ impl Progress {
     ) {
         let msg = format!(
             "t = {t:.4e} s, step {step}, dt = {dt:.3e} ({}), {rate:.3e} particle-steps/s",
-            DT_LIMIT_NAMES[limit as usize % 4]
+            dt_limit_name(limit)
         );
         if let Some(b) = &self.bar {
             b.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64);

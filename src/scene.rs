@@ -60,6 +60,9 @@ pub enum PhaseKind {
     Liquid,
     Gas,
     Wall,
+    /// Fixed substrate that conducts heat: a wall for the fluid, a thermal body
+    /// for the heat passes (F22 §3.2: solid particles of a fixed substrate).
+    Solid,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -160,6 +163,15 @@ pub struct Material {
     pub sound_speed: Option<f64>,
     /// Reference pressure p0 = ρ0 c² in Pa (F22 §4.1 uses 1e7 Pa).
     pub reference_pressure: Option<f64>,
+    /// Thermal conductivity k in W/(m K) (heat scenes).
+    pub conductivity: Option<f64>,
+    /// Specific heat capacity c_p in J/(kg K) (heat scenes).
+    pub heat_capacity: Option<f64>,
+    /// Melting band [solidus, liquidus] in K and latent heat of melting in J/kg
+    /// (J22 (19): h(T) = c_p T + L f_l(T), f_l linear over the band).
+    pub solidus: Option<f64>,
+    pub liquidus: Option<f64>,
+    pub latent_heat: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -171,6 +183,10 @@ pub struct PhaseDef {
     pub slip: Slip,
     /// Prescribed velocity of a wall phase (m/s); walls do not move in position.
     pub velocity: Option<Vec<f64>>,
+    /// Initial temperature in K. Giving it to any phase makes the scene a heat scene;
+    /// on a wall phase it is a fixed (Dirichlet) temperature, and a wall phase
+    /// without one is adiabatic.
+    pub temperature: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -274,6 +290,13 @@ pub enum CheckKind {
     Couette,
     DamBreakFront,
     TwoLayer,
+    /// Semi-infinite solid, surface held at a fixed temperature: erf solution.
+    #[serde(rename = "conduction_1d")]
+    Conduction1d,
+    /// Steady conduction through two layers between two Dirichlet walls.
+    ConductionTwoMaterials,
+    /// Closed adiabatic box: total enthalpy constant.
+    Adiabatic,
 }
 
 impl CheckKind {
@@ -285,6 +308,9 @@ impl CheckKind {
             CheckKind::Couette => "couette",
             CheckKind::DamBreakFront => "dam_break_front",
             CheckKind::TwoLayer => "two_layer",
+            CheckKind::Conduction1d => "conduction_1d",
+            CheckKind::ConductionTwoMaterials => "conduction_two_materials",
+            CheckKind::Adiabatic => "adiabatic",
         }
     }
 }

@@ -7,7 +7,7 @@
 use crate::error::InputError;
 use crate::model::Model;
 use crate::scene::{SceneFile, ShapeDef};
-use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE};
+use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE, BYTES_PER_PARTICLE_HEAT};
 
 /// Lattice coordinates along one axis: positions and whether each is in a wall layer.
 fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
@@ -55,7 +55,13 @@ fn axis_sites_len(m: &Model, a: usize) -> f64 {
 
 /// Estimated memory of the scene in bytes.
 pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
-    particles * BYTES_PER_PARTICLE as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
+    let per_particle = BYTES_PER_PARTICLE
+        + if m.is_thermal() {
+            BYTES_PER_PARTICLE_HEAT
+        } else {
+            0
+        };
+    particles * per_particle as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
 }
 
 /// Memory this machine has free, from /proc/meminfo (None where unknown).
@@ -159,7 +165,7 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
             (lo, hi, "cylinder")
         };
         // A fluid shape must lie in the domain: particles outside would start in the walls.
-        if m.phases[pi].is_fluid() {
+        if m.phases[pi].kind != crate::scene::PhaseKind::Wall {
             let tol = 1e-9 * m.dx;
             for a in 0..dim {
                 if lo[a] < m.domain_lo[a] - tol || hi[a] > m.domain_hi[a] + tol {
@@ -264,8 +270,12 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
             }
         }
     }
-    if !st.phase.iter().any(|&p| m.phases[p as usize].is_fluid()) {
-        return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid particle (no shape of a liquid or gas phase covers a lattice site)"));
+    if !st
+        .phase
+        .iter()
+        .any(|&p| m.phases[p as usize].is_fluid() || m.phases[p as usize].conducts())
+    {
+        return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid or solid particle (no shape of a liquid, gas or solid phase covers a lattice site)"));
     }
     Ok(st)
 }
@@ -293,4 +303,22 @@ fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
     st.mass.push(ph.mass as f32);
     st.phase.push(pi as u32);
     st.id.push(id);
+    if m.is_thermal() {
+        st.heat.push(initial_heat(ph));
+    }
+}
+
+/// Enthalpy and temperature at setup. The heat.temperature pass recomputes T and
+/// f_l from h before the first step; a Dirichlet wall keeps its temperature.
+fn initial_heat(ph: &crate::model::PhaseInfo) -> [f32; 4] {
+    match ph.thermal {
+        Some(t) if ph.conducts() => [
+            t.enthalpy(t.temperature) as f32,
+            t.temperature as f32,
+            0.0,
+            0.0,
+        ],
+        Some(t) => [0.0, t.temperature as f32, 0.0, 0.0],
+        None => [0.0; 4],
+    }
 }

@@ -17,7 +17,15 @@ pub struct Sim {
     pub _pad: [u32; 2],
 }
 
-pub const DT_LIMIT_NAMES: [&str; 4] = ["acoustic", "viscous", "force", "fixed"];
+pub const DT_LIMIT_NAMES: [&str; 5] = ["acoustic", "viscous", "force", "fixed", "conduction"];
+
+/// Name of the limit code the timestep pass wrote.
+pub fn dt_limit_name(code: u32) -> &'static str {
+    DT_LIMIT_NAMES
+        .get(code as usize)
+        .copied()
+        .unwrap_or("unknown")
+}
 
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct State {
@@ -34,6 +42,9 @@ pub struct State {
     pub mass: Vec<f32>,
     pub phase: Vec<u32>,
     pub id: Vec<u32>,
+    /// Heat scenes only (empty otherwise): specific enthalpy h (J/kg), temperature
+    /// T (K), liquid fraction f_l, dh/dt of the last step (W/kg).
+    pub heat: Vec<[f32; 4]>,
     pub sim: Sim,
 }
 
@@ -74,6 +85,9 @@ impl State {
                 is_float: false,
             },
         ]
+        .into_iter()
+        .chain((!self.heat.is_empty()).then(|| vec4_field("heat", &self.heat)))
+        .collect()
     }
 }
 
@@ -98,5 +112,7 @@ fn scalar_field<'a>(name: &'static str, v: &'a [f32]) -> FieldView<'a> {
 /// Bytes the device and host hold per particle: the state above, the reorder scratch
 /// (5 vec4) and padded sort keys (2 × 8 bytes).
 pub const BYTES_PER_PARTICLE: u64 = 4 * 16 + 5 * 4 + 5 * 16 + 16;
+/// Extra bytes per particle in a heat scene: the heat vec4 and its reorder scratch.
+pub const BYTES_PER_PARTICLE_HEAT: u64 = 2 * 16;
 /// Bytes per grid cell: start and end tables.
 pub const BYTES_PER_CELL: u64 = 8;

@@ -19,6 +19,10 @@ pub enum Stage {
     Wall,
     /// forces.wgsl: F22 (23) pressure + viscous forces, background pressure, gravity.
     Forces,
+    /// heat.wgsl `conduct`: conduction dh/dt and the explicit Euler enthalpy update.
+    Heat,
+    /// heat.wgsl `temperature`: T and liquid fraction from the enthalpy.
+    Temperature,
     /// integrate.wgsl `kick`: second half kick.
     Kick,
     /// timestep.wgsl: max |u|, |a| reductions and the F22 (42) time step.
@@ -33,6 +37,8 @@ impl Stage {
             Stage::Density => "density",
             Stage::Wall => "wall",
             Stage::Forces => "forces",
+            Stage::Heat => "heat.conduct",
+            Stage::Temperature => "heat.temperature",
             Stage::Kick => "integrate.kick",
             Stage::Timestep => "timestep",
         }
@@ -41,43 +47,52 @@ impl Stage {
     pub fn pass(self) -> &'static str {
         match self {
             Stage::KickDrift | Stage::Kick => "integrate",
+            Stage::Heat | Stage::Temperature => "heat",
             other => other.name(),
         }
     }
 }
 
-/// One velocity-Verlet (kick–drift–kick) step with every stage a WCSPH scene can need.
-pub const STEP: [Stage; 7] = [
+/// One velocity-Verlet (kick–drift–kick) step with every stage a scene can need.
+/// Heat is explicit Euler inside the step: conduction reads the temperatures of the
+/// previous step, then the temperatures follow the new enthalpies.
+pub const STEP: [Stage; 9] = [
     Stage::KickDrift,
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Forces,
+    Stage::Heat,
+    Stage::Temperature,
     Stage::Kick,
     Stage::Timestep,
 ];
 
-/// Run once before the first step: accelerations and Δt of the initial state.
-pub const PRIME: [Stage; 5] = [
+/// Run once before the first step: accelerations, temperatures and Δt of the
+/// initial state.
+pub const PRIME: [Stage; 6] = [
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Forces,
+    Stage::Temperature,
     Stage::Timestep,
 ];
 
 /// The compute passes in the order `spatter validate` lists them.
-const PASS_ORDER: [&str; 6] = [
+const PASS_ORDER: [&str; 7] = [
     "neighbors",
     "density",
     "wall",
     "forces",
+    "heat",
     "integrate",
     "timestep",
 ];
 
 /// The stages a scene runs: only what its physics needs (DESIGN.md). A scene
-/// without wall particles has no wall pass.
+/// without wall particles has no wall pass, a scene without fluid no flow passes,
+/// a scene without temperature no heat pass (and no heat buffers).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Pipeline {
     pub step: Vec<Stage>,
@@ -87,7 +102,14 @@ pub struct Pipeline {
 impl Pipeline {
     pub fn for_scene(params: &Params, st: &State) -> Pipeline {
         let walls = st.phase.iter().any(|&p| params.is_wall(p));
-        let needed = |s: &&Stage| walls || **s != Stage::Wall;
+        let fluid = st.phase.iter().any(|&p| !params.is_wall(p));
+        let heat = params.heat[2] != 0.0;
+        let needed = |s: &&Stage| match **s {
+            Stage::Wall => walls && fluid,
+            Stage::KickDrift | Stage::Density | Stage::Forces | Stage::Kick => fluid,
+            Stage::Heat | Stage::Temperature => heat,
+            Stage::Neighbors | Stage::Timestep => true,
+        };
         Pipeline {
             step: STEP.iter().filter(needed).copied().collect(),
             prime: PRIME.iter().filter(needed).copied().collect(),

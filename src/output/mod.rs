@@ -10,7 +10,7 @@ pub mod vtk;
 
 use crate::model::Model;
 use crate::scene::PhaseKind;
-use crate::state::{State, DT_LIMIT_NAMES};
+use crate::state::{dt_limit_name, State, DT_LIMIT_NAMES};
 use serde::Serialize;
 
 /// Values of one per-particle field, in particle (array) order.
@@ -75,6 +75,31 @@ pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
         f("phase", Values::U32(st.phase.clone())),
         f("id", Values::U32(st.id.clone())),
     ]
+    .into_iter()
+    .chain(heat_fields(st))
+    .collect()
+}
+
+/// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).
+fn heat_fields(st: &State) -> Vec<Field> {
+    if st.heat.is_empty() {
+        return Vec::new();
+    }
+    let col = |k: usize| Values::F32(st.heat.iter().map(|h| h[k]).collect());
+    vec![
+        Field {
+            name: "temperature",
+            values: col(1),
+        },
+        Field {
+            name: "liquid_fraction",
+            values: col(2),
+        },
+        Field {
+            name: "enthalpy",
+            values: col(0),
+        },
+    ]
 }
 
 /// One `/diagnostics` record. Fluid particles only: wall particles carry
@@ -100,7 +125,7 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         time: st.sim.time as f64,
         step: st.sim.step as u64,
         dt: st.sim.dt as f64,
-        dt_limit: DT_LIMIT_NAMES[st.sim.dt_limit as usize % 4].to_string(),
+        dt_limit: dt_limit_name(st.sim.dt_limit).to_string(),
         kinetic_energy: 0.0,
         total_mass: 0.0,
         max_speed: 0.0,

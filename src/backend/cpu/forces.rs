@@ -39,7 +39,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                 let dwdr = kernel::dw(pr, r);
                 let ph_j = phase[j];
                 let mat_j = pr.phase_a[ph_j as usize];
-                let wall = mat_j[3] == crate::params::KIND_WALL;
+                let wall = mat_j[3] >= crate::params::KIND_WALL;
                 let p_j = p[j];
                 let (rho_j, m_j, eta_j) = if wall {
                     (mat_i[0] + p_j / mat_i[1], m_i, eta_i)

@@ -4,6 +4,7 @@
 
 mod density;
 mod forces;
+mod heat;
 mod integrate;
 mod neighbors;
 mod timestep;
@@ -72,6 +73,8 @@ impl Backend for CpuBackend {
             Stage::Density => density::run(pr, &mut self.st, &self.grid),
             Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
             Stage::Forces => forces::run(pr, &mut self.st, &self.grid),
+            Stage::Heat => heat::conduct(pr, &mut self.st, &self.grid),
+            Stage::Temperature => heat::temperature(pr, &mut self.st),
             Stage::Kick => integrate::kick(pr, &mut self.st),
             Stage::Timestep => timestep::run(pr, &mut self.st),
         }

@@ -107,6 +107,9 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     permute(&mut st.mass, &perm);
     permute(&mut st.phase, &perm);
     permute(&mut st.id, &perm);
+    if !st.heat.is_empty() {
+        permute(&mut st.heat, &perm);
+    }
     let n_cells = pr.counts[1] as usize;
     grid.start.clear();
     grid.start.resize(n_cells, 0);

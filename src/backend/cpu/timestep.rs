@@ -31,14 +31,24 @@ pub fn run(pr: &Params, st: &mut State) {
     sim.dt_limit = which;
 }
 
-/// The F22 (42) limit that binds: 0 acoustic, 1 viscous, 2 force, 3 fixed.
+/// The F22 (42) limit that binds: 0 acoustic, 1 viscous, 2 force, 3 fixed,
+/// 4 conduction (0.1 ρ c_p h²/k, issue 4). A scene without fluid has no acoustic
+/// limit (c_max = 0, |u| = 0).
 pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
     let h = pr.dt[0];
-    let mut dt = 0.25 * h / (pr.dt[1] + umax2.sqrt());
+    let speed = pr.dt[1] + umax2.sqrt();
+    let mut dt = f32::MAX;
+    if speed > 0.0 {
+        dt = 0.25 * h / speed;
+    }
     let mut which = 0u32;
     if pr.dt[2] < dt {
         dt = pr.dt[2];
         which = 1;
+    }
+    if pr.heat[0] < dt {
+        dt = pr.heat[0];
+        which = 4;
     }
     if amax2 > 0.0 {
         let f = 0.25 * (h / amax2.sqrt()).sqrt();

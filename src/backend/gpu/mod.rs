@@ -18,20 +18,21 @@ const REDUCE_WG: u32 = 256;
 /// Stride between sort-stage uniforms (the usual min_uniform_buffer_offset_alignment).
 const STAGE_STRIDE: u64 = 256;
 
-const SHADERS: [(&str, &str); 6] = [
+const SHADERS: [(&str, &str); 7] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
     ("forces", include_str!("../../../shaders/forces.wgsl")),
     ("integrate", include_str!("../../../shaders/integrate.wgsl")),
     ("timestep", include_str!("../../../shaders/timestep.wgsl")),
+    ("heat", include_str!("../../../shaders/heat.wgsl")),
 ];
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 /// Portable exp/ln/pow, prepended to every pass (twin of src/portable_math.rs).
 const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
-const ENTRY_POINTS: [(&str, &str, &str); 11] = [
+const ENTRY_POINTS: [(&str, &str, &str); 14] = [
     ("cell_keys", "neighbors", "cell_keys"),
     ("bitonic", "neighbors", "bitonic"),
     ("reorder", "neighbors", "reorder"),
@@ -43,6 +44,9 @@ const ENTRY_POINTS: [(&str, &str, &str); 11] = [
     ("kick", "integrate", "kick"),
     ("reduce", "timestep", "reduce"),
     ("finalize", "timestep", "finalize"),
+    ("wall_temperature", "heat", "wall_temperature"),
+    ("conduct", "heat", "conduct"),
+    ("temperature", "heat", "temperature"),
 ];
 
 struct Buffers {
@@ -63,6 +67,9 @@ struct Buffers {
     sim: wgpu::Buffer,
     partials: wgpu::Buffer,
     sort_stages: wgpu::Buffer,
+    /// (h, T, f_l, dh/dt) and its reorder scratch; 16-byte placeholders without heat.
+    heat: wgpu::Buffer,
+    s_heat: wgpu::Buffer,
 }
 
 pub struct GpuBackend {
@@ -113,6 +120,8 @@ impl GpuBackend {
         let pipeline = Pipeline::for_scene(&params, st);
         let v4 = n as u64 * 16;
         let s1 = n as u64 * 4;
+        let thermal = !st.heat.is_empty();
+        let heat_bytes = if thermal { v4 } else { 16 };
         let stages = sort_stages(n_pad);
         let mut stage_bytes = vec![0u8; stages.len().max(1) * STAGE_STRIDE as usize];
         for (k, (j, kk)) in stages.iter().enumerate() {
@@ -154,6 +163,8 @@ impl GpuBackend {
                 contents: &stage_bytes,
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
+            heat: storage(device, "heat", heat_bytes),
+            s_heat: storage(device, "s_heat", heat_bytes),
         };
         let (layout, sort_layout) = layouts(device);
         let bind = main_bind_group(device, &layout, &buf);
@@ -214,7 +225,14 @@ impl GpuBackend {
         q.write_buffer(&b.phase, 0, bytemuck::cast_slice(&st.phase));
         q.write_buffer(&b.id, 0, bytemuck::cast_slice(&st.id));
         q.write_buffer(&b.sim, 0, bytemuck::bytes_of(&st.sim));
+        if self.thermal() {
+            q.write_buffer(&b.heat, 0, bytemuck::cast_slice(&st.heat));
+        }
         q.submit([]);
+    }
+
+    fn thermal(&self) -> bool {
+        self.params.heat[2] != 0.0
     }
 
     fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, threads: u32) {
@@ -262,6 +280,11 @@ impl GpuBackend {
         let n = self.n;
         match stage {
             Stage::Neighbors => self.encode_neighbors(enc, idx),
+            Stage::Heat => {
+                let mut pass = self.begin_pass(enc, stage, idx);
+                self.dispatch(&mut pass, "wall_temperature", n);
+                self.dispatch(&mut pass, "conduct", n);
+            }
             Stage::Timestep => {
                 let mut pass = self.begin_pass(enc, stage, idx);
                 pass.set_pipeline(&self.pipelines["reduce"]);
@@ -277,7 +300,8 @@ impl GpuBackend {
                     Stage::Wall => "wall",
                     Stage::Forces => "forces",
                     Stage::Kick => "kick",
-                    Stage::Neighbors | Stage::Timestep => unreachable!(),
+                    Stage::Temperature => "temperature",
+                    Stage::Neighbors | Stage::Timestep | Stage::Heat => unreachable!(),
                 };
                 let mut pass = self.begin_pass(enc, stage, idx);
                 self.dispatch(&mut pass, name, n);
@@ -301,6 +325,9 @@ impl GpuBackend {
         let targets = [&b.pos, &b.vel, &b.acc, &b.acc_b, &b.mass, &b.phase, &b.id];
         for (src, dst) in b.scratch.iter().zip(targets) {
             enc.copy_buffer_to_buffer(src, 0, dst, 0, dst.size());
+        }
+        if self.thermal() {
+            enc.copy_buffer_to_buffer(&b.s_heat, 0, &b.heat, 0, b.heat.size());
         }
         enc.clear_buffer(&b.cell_start, 0, None);
         enc.clear_buffer(&b.cell_end, 0, None);
@@ -413,7 +440,7 @@ fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayo
         },
         count: None,
     }];
-    for b in 1..=21 {
+    for b in 1..=23 {
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: b,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -450,7 +477,7 @@ fn main_bind_group(
     layout: &wgpu::BindGroupLayout,
     b: &Buffers,
 ) -> wgpu::BindGroup {
-    let list: [&wgpu::Buffer; 22] = [
+    let list: [&wgpu::Buffer; 24] = [
         &b.params,
         &b.pos,
         &b.vel,
@@ -473,6 +500,8 @@ fn main_bind_group(
         &b.scratch[6],
         &b.sim,
         &b.partials,
+        &b.heat,
+        &b.s_heat,
     ];
     let entries: Vec<wgpu::BindGroupEntry> = list
         .iter()
@@ -592,6 +621,11 @@ impl Backend for GpuBackend {
             mass: self.read_vec(&b.mass),
             phase: self.read_vec(&b.phase),
             id: self.read_vec(&b.id),
+            heat: if self.thermal() {
+                self.read_vec(&b.heat)
+            } else {
+                Vec::new()
+            },
             sim: self.read_sim(),
         }
     }

@@ -1,0 +1,122 @@
+// Heat conduction in enthalpy form and temperature from enthalpy.
+// Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
+
+// Density for a particle's volume: summation density for fluids, rho0 for solids
+// and walls.
+fn heat_density(ph: u32, i: u32) -> f32 {
+    if (is_wall(ph)) {
+        return P.phase_a[ph].x;
+    }
+    return rho[i];
+}
+
+// Dirichlet wall particles: T = 2 T_wall - (Shepard mean of conducting neighbours).
+@compute @workgroup_size(64)
+fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (conducts(ph) || (heat_flags(ph) & HEAT_DIRICHLET) == 0u) { return; }
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var sw = 0.0;
+    var stw = 0.0;
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let r2 = len2(min_image(pi, pos[j]));
+                    if (r2 < P.kern.w && conducts(phase[j])) {
+                        let wk = kernel_w(sqrt(r2));
+                        sw = sw + wk;
+                        stw = stw + heat[j].y * wk;
+                    }
+                }
+            }
+        }
+    }
+    let t_wall = P.phase_d[ph].x;
+    var hv = heat[i];
+    if (sw > 0.0) {
+        hv.y = c_two() * t_wall - stw / sw;
+    } else {
+        hv.y = t_wall;
+    }
+    heat[i] = hv;
+}
+
+@compute @workgroup_size(64)
+fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph_i = phase[i];
+    if (!conducts(ph_i)) { return; }
+    let k_i = P.phase_c[ph_i].x;
+    let t_i = heat[i].y;
+    let eta2 = P.heat.y;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var sum = 0.0;
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let r2 = len2(min_image(pi, pos[j]));
+                    if (r2 >= P.kern.w || r2 <= 0.0) { continue; }
+                    let ph_j = phase[j];
+                    var k_ij = 0.0;
+                    if (conducts(ph_j)) {
+                        let k_j = P.phase_c[ph_j].x;
+                        k_ij = c_four() * k_i * k_j / (k_i + k_j);
+                    } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
+                        k_ij = c_two() * k_i;
+                    } else {
+                        continue;
+                    }
+                    let r = sqrt(r2);
+                    let f = kernel_dw(r) * r / (r2 + eta2);
+                    let v_j = mass[j] / heat_density(ph_j, j);
+                    sum = sum + v_j * k_ij * (t_i - heat[j].y) * f;
+                }
+            }
+        }
+    }
+    let rate = sum / heat_density(ph_i, i);
+    // Neighbours read only T (.y), so the enthalpy can be updated in place.
+    var hv = heat[i];
+    hv.x = hv.x + sim.dt * rate;
+    hv.w = rate;
+    heat[i] = hv;
+}
+
+@compute @workgroup_size(64)
+fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (!conducts(ph)) { return; }
+    var hv = heat[i];
+    let h = hv.x;
+    let c = P.phase_c[ph];
+    let d = P.phase_d[ph];
+    let flags = heat_flags(ph);
+    if ((flags & HEAT_MELTS) == 0u) {
+        hv.y = h / c.y;
+        hv.z = select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u);
+    } else if (h <= c.z) {
+        hv.y = h / c.y;
+        hv.z = 0.0;
+    } else if (h >= c.w) {
+        hv.y = (h - d.z) / c.y;
+        hv.z = 1.0;
+    } else {
+        let f = (h - c.z) / (c.w - c.z);
+        hv.y = d.x + f * (d.y - d.x);
+        hv.z = f;
+    }
+    heat[i] = hv;
+}

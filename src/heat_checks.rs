@@ -1,0 +1,146 @@
+//! Heat reference solutions (issue 4, PHYSICS.md §9): conduction into a
+//! semi-infinite solid (erf), steady conduction through two layers, and enthalpy
+//! conservation in an adiabatic box.
+
+use crate::model::Model;
+use crate::state::State;
+
+/// (axis coordinate, temperature, phase) of every conducting particle.
+fn conducting(m: &Model, st: &State) -> Vec<(f64, f64, usize)> {
+    let ax = m.dim as usize - 1;
+    (0..st.len())
+        .filter(|&i| m.phases[st.phase[i] as usize].conducts())
+        .map(|i| {
+            (
+                st.pos[i][ax] as f64 + m.origin[ax],
+                st.heat[i][1] as f64,
+                st.phase[i] as usize,
+            )
+        })
+        .collect()
+}
+
+/// Prescribed temperatures of the Dirichlet walls below and above the domain.
+fn wall_temperatures(m: &Model, st: &State) -> (Option<f64>, Option<f64>) {
+    let ax = m.dim as usize - 1;
+    let (mut lo, mut hi) = (None, None);
+    for i in 0..st.len() {
+        let ph = &m.phases[st.phase[i] as usize];
+        let Some(th) = ph.thermal.filter(|_| !ph.conducts()) else {
+            continue;
+        };
+        let x = st.pos[i][ax] as f64 + m.origin[ax];
+        if x < m.domain_lo[ax] {
+            lo = Some(th.temperature);
+        } else if x > m.domain_hi[ax] {
+            hi = Some(th.temperature);
+        }
+    }
+    (lo, hi)
+}
+
+fn max_error(
+    pts: &[(f64, f64, usize)],
+    scale: f64,
+    reference: impl Fn(f64, usize) -> f64,
+) -> (f64, f64) {
+    let (mut worst, mut se) = (0.0f64, 0.0);
+    for &(x, t, ph) in pts {
+        let e = (t - reference(x, ph)).abs() / scale;
+        worst = worst.max(e);
+        se += e * e;
+    }
+    (worst, (se / pts.len().max(1) as f64).sqrt())
+}
+
+/// T(y, t) = T_w + (T_0 − T_w) erf(y / (2√(αt))), y from the wall face at the
+/// lower side of the last axis (Carslaw & Jaeger §2.4).
+pub fn conduction_1d(m: &Model, st: &State) -> (String, f64, Vec<String>) {
+    let pts = conducting(m, st);
+    let (Some(tw), _) = wall_temperatures(m, st) else {
+        return (
+            "max |T - T_erf| / |T0 - Tw|".into(),
+            f64::NAN,
+            vec!["  no Dirichlet wall below the solid".into()],
+        );
+    };
+    let ph = &m.phases[pts[0].2];
+    let th = ph.thermal.unwrap();
+    let alpha = th.conductivity / (ph.rho0 * th.heat_capacity);
+    let t = st.sim.time as f64;
+    let t0 = th.temperature;
+    let y0 = m.domain_lo[m.dim as usize - 1];
+    let depth = 2.0 * (alpha * t).sqrt();
+    let (worst, rms) = max_error(&pts, (t0 - tw).abs(), |y, _| {
+        tw + (t0 - tw) * libm::erf((y - y0) / depth)
+    });
+    let details = vec![format!(
+        "  t = {t:.4e} s, alpha = {alpha:.4e} m^2/s, diffusion length 2 sqrt(alpha t) = {depth:.4e} m, {} particles, rms error {:.3e}",
+        pts.len(),
+        rms
+    )];
+    ("max |T - T_erf| / |T0 - Tw|".into(), worst, details)
+}
+
+/// Steady 1D conduction between two Dirichlet walls through a layer of
+/// conductivity k_1 below `interface` and k_2 above: temperature linear in the
+/// thermal resistance ∫dy/k.
+pub fn two_materials(m: &Model, st: &State, interface: f64) -> (String, f64, Vec<String>) {
+    let metric = "max |T - T_steady| / |T_hi - T_lo|".to_string();
+    let pts = conducting(m, st);
+    let (Some(t_lo), Some(t_hi)) = wall_temperatures(m, st) else {
+        return (
+            metric,
+            f64::NAN,
+            vec!["  needs Dirichlet walls on both sides".into()],
+        );
+    };
+    let k_of = |below: bool| {
+        pts.iter()
+            .find(|p| (p.0 < interface) == below)
+            .map(|p| m.phases[p.2].thermal.unwrap().conductivity)
+            .unwrap_or(f64::NAN)
+    };
+    let (k1, k2) = (k_of(true), k_of(false));
+    let ax = m.dim as usize - 1;
+    let (y0, y1) = (m.domain_lo[ax], m.domain_hi[ax]);
+    let resistance = |y: f64| {
+        if y <= interface {
+            (y - y0) / k1
+        } else {
+            (interface - y0) / k1 + (y - interface) / k2
+        }
+    };
+    let total = resistance(y1);
+    let (worst, rms) = max_error(&pts, (t_hi - t_lo).abs(), |y, _| {
+        t_lo + (t_hi - t_lo) * resistance(y) / total
+    });
+    let t_if = t_lo + (t_hi - t_lo) * resistance(interface) / total;
+    let details = vec![format!(
+        "  k = {k1} / {k2} W/(m K), walls {t_lo} K / {t_hi} K, interface {t_if:.4} K, t = {:.4e} s, rms error {rms:.3e}",
+        st.sim.time
+    )];
+    (metric, worst, details)
+}
+
+/// Σ m h over conducting particles (J per metre of depth in 2D).
+pub fn total_enthalpy(m: &Model, st: &State) -> f64 {
+    (0..st.len())
+        .filter(|&i| m.phases[st.phase[i] as usize].conducts())
+        .map(|i| st.mass[i] as f64 * st.heat[i][0] as f64)
+        .sum()
+}
+
+pub fn adiabatic(m: &Model, st: &State, initial: f64) -> (String, f64, Vec<String>) {
+    let now = total_enthalpy(m, st);
+    let drift = (now - initial).abs() / initial.abs();
+    let temps: Vec<f64> = conducting(m, st).iter().map(|p| p.1).collect();
+    let (lo, hi) = temps
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &t| (a.0.min(t), a.1.max(t)));
+    let details = vec![format!(
+        "  {} steps; enthalpy {initial:.9e} -> {now:.9e}; temperatures now {lo:.3} .. {hi:.3} K",
+        st.sim.step
+    )];
+    ("|H - H0| / |H0|".into(), drift, details)
+}

@@ -77,6 +77,9 @@ pub struct Checker {
     max_penetration: f64,
     /// Total enthalpy at the first sample (adiabatic check).
     initial_enthalpy: Option<f64>,
+    /// (t, simulated front, exact front) per sample (Stefan check), and its header.
+    fronts: Vec<(f64, f64, f64)>,
+    front_info: String,
 }
 
 impl Checker {
@@ -87,6 +90,8 @@ impl Checker {
             samples: Vec::new(),
             max_penetration: 0.0,
             initial_enthalpy: None,
+            fronts: Vec::new(),
+            front_info: String::new(),
         })
     }
 
@@ -107,6 +112,14 @@ impl Checker {
             CheckKind::Adiabatic => {
                 self.initial_enthalpy
                     .get_or_insert(heat_checks::total_enthalpy(m, st));
+            }
+            CheckKind::Stefan1d => {
+                if let Some((front, exact, info)) = heat_checks::stefan_fronts(m, st) {
+                    if self.fronts.last().is_none_or(|f| f.0 < t) {
+                        self.fronts.push((t, front, exact));
+                    }
+                    self.front_info = info;
+                }
             }
             _ => {}
         }
@@ -133,6 +146,7 @@ impl Checker {
             CheckKind::Adiabatic => {
                 heat_checks::adiabatic(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
             }
+            CheckKind::Stefan1d => heat_checks::stefan_1d(m, &self.fronts, &self.front_info),
         };
         let pass = value.is_finite() && value <= self.tolerance;
         CheckResult {

@@ -385,8 +385,8 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     let l = &m.limits;
     let (lim, which) = l.min();
     println!(
-        "time-step limits: acoustic {:.4e} s, viscous {:.4e} s, body force {:.4e} s; binding: {which}",
-        l.acoustic, l.viscous, l.body_force
+        "time-step limits: acoustic {:.4e} s, viscous {:.4e} s, body force {:.4e} s, conduction {:.4e} s; binding: {which}",
+        l.acoustic, l.viscous, l.body_force, l.conduction
     );
     match m.fixed_dt {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),

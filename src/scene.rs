@@ -297,6 +297,9 @@ pub enum CheckKind {
     ConductionTwoMaterials,
     /// Closed adiabatic box: total enthalpy constant.
     Adiabatic,
+    /// One-phase Stefan problem: melting front s(t) = 2λ√(α t).
+    #[serde(rename = "stefan_1d")]
+    Stefan1d,
 }
 
 impl CheckKind {
@@ -311,6 +314,7 @@ impl CheckKind {
             CheckKind::Conduction1d => "conduction_1d",
             CheckKind::ConductionTwoMaterials => "conduction_two_materials",
             CheckKind::Adiabatic => "adiabatic",
+            CheckKind::Stefan1d => "stefan_1d",
         }
     }
 }

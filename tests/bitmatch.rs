@@ -81,3 +81,32 @@ fn compare_cli_dam_break_3d_200_steps() {
     );
     assert_eq!(out.status.code(), Some(0));
 }
+
+/// Heat (issue 4): conduction with Dirichlet walls and two materials, melting
+/// through the enthalpy band, an adiabatic box, and heat carried by a flowing 3D
+/// liquid (reordered every step with the other arrays).
+#[test]
+fn heat_passes_200_steps() {
+    assert_bit_identical("stefan_1d", &["dx=2e-3"], 200);
+    assert_bit_identical("conduction_two_materials", &[], 200);
+    assert_bit_identical("adiabatic_box", &[], 200);
+}
+
+const HOT_WATER: [&str; 4] = [
+    "materials.water.conductivity=0.6",
+    "materials.water.heat_capacity=4186.0",
+    "phases.water.temperature=350.0",
+    "phases.wall.temperature=290.0",
+];
+
+#[test]
+fn heat_in_a_flowing_liquid_3d_200_steps() {
+    let mut sets = HOT_WATER.to_vec();
+    sets.push("dx=0.02");
+    assert_bit_identical("dam_break_3d", &sets, 200);
+}
+
+#[test]
+fn heat_in_a_flowing_liquid_2d_200_steps() {
+    assert_bit_identical("dam_break_2d", &HOT_WATER, 200);
+}

@@ -1,0 +1,115 @@
+//! Heat (issue 4): each validation scene's [check] against its reference solution,
+//! the Stefan front at three resolutions, and which passes a scene runs.
+
+mod common;
+use common::{scene, spatter, text};
+
+/// Run a scene on the CPU; return the check's value and print its lines.
+fn check_value(name: &str, sets: &[&str]) -> (f64, bool) {
+    let mut args = vec!["run", "--backend", "cpu"];
+    let path = scene(name);
+    args.push(&path);
+    for s in sets {
+        args.extend_from_slice(&["--set", s]);
+    }
+    let out = spatter(&args);
+    let (stdout, stderr) = text(&out);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("check "))
+        .unwrap_or_else(|| panic!("no check line: {stdout}{stderr}"));
+    println!("{name} {sets:?}\n{stdout}");
+    let value: f64 = line
+        .split(" = ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    (
+        value,
+        line.ends_with("PASS") && out.status.code() == Some(0),
+    )
+}
+
+#[test]
+fn conduction_1d_within_1_percent_of_erf() {
+    let (v, pass) = check_value("conduction_1d", &[]);
+    assert!(pass && v <= 0.01, "{v}");
+}
+
+#[test]
+fn two_materials_steady_profile_within_1_percent() {
+    let (v, pass) = check_value("conduction_two_materials", &[]);
+    assert!(pass && v <= 0.01, "{v}");
+}
+
+#[test]
+fn adiabatic_box_conserves_enthalpy_to_1e_6_over_1e4_steps() {
+    let (v, pass) = check_value("adiabatic_box", &[]);
+    assert!(pass && v <= 1e-6, "{v}");
+}
+
+/// Issue 4: Stefan front within 3% at the finest of three resolutions, the error
+/// falling as Δx falls.
+#[test]
+fn stefan_front_converges_and_is_within_3_percent() {
+    let errors: Vec<f64> = ["dx=4e-3", "dx=2e-3", "dx=1e-3"]
+        .iter()
+        .map(|s| check_value("stefan_1d", &[s]).0)
+        .collect();
+    println!("stefan_1d rms front error at dx = 4, 2, 1 mm: {errors:?}");
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+    assert!(errors[2] <= 0.03, "{errors:?}");
+}
+
+fn passes(name: &str, sets: &[&str]) -> String {
+    let path = scene(name);
+    let mut args = vec!["validate", path.as_str()];
+    for s in sets {
+        args.extend_from_slice(&["--set", s]);
+    }
+    let out = spatter(&args);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    stdout
+        .lines()
+        .find(|l| l.starts_with("passes: "))
+        .unwrap()
+        .to_string()
+}
+
+#[test]
+fn validate_lists_heat_only_where_there_is_temperature() {
+    assert_eq!(
+        passes("dam_break_3d", &[]),
+        "passes: neighbors, density, wall, forces, integrate, timestep"
+    );
+    // A solid-only heat scene runs no flow pass.
+    assert_eq!(
+        passes("stefan_1d", &[]),
+        "passes: neighbors, heat, timestep"
+    );
+    let hot = [
+        "materials.water.conductivity=0.6",
+        "materials.water.heat_capacity=4186.0",
+        "phases.water.temperature=350.0",
+    ];
+    assert_eq!(
+        passes("dam_break_3d", &hot),
+        "passes: neighbors, density, wall, forces, heat, integrate, timestep"
+    );
+}
+
+#[test]
+fn conduction_limit_binds_and_is_named() {
+    let out = spatter(&["validate", &scene("conduction_1d")]);
+    let (stdout, _) = text(&out);
+    assert!(
+        stdout.contains("binding: conduction 0.1 rho c_p h^2/k"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("conduction 1.0000e-1 s"), "{stdout}");
+}

@@ -17,6 +17,12 @@ struct Params {
     phase_c: array<vec4<f32>, 8>, // heat: k, c_p, h_solidus, h_liquidus
     phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
     heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
+    laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, on (1/0)
+    laser_grid: vec4<f32>,        // bin size, peak irradiance per watt, bin volume, column area
+    laser_bins: vec4<u32>,        // bins per axis, path points + 256 * power steps
+    laser_lo: vec4<f32>,          // bin grid lower corner (grid-relative)
+    laser_path: array<vec4<f32>, 8>,  // time, lateral beam centre
+    laser_power: array<vec4<f32>, 8>, // time, power from then on
     consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
 }
 
@@ -64,6 +70,8 @@ const WG: u32 = 64u;
 // otherwise (no heat pass is dispatched).
 @group(0) @binding(22) var<storage, read_write> heat: array<vec4<f32>>;
 @group(0) @binding(23) var<storage, read_write> s_heat: array<vec4<f32>>;
+// Laser scenes: per bin (sum of w V, absorbed power); a placeholder otherwise.
+@group(0) @binding(24) var<storage, read_write> bins: array<vec2<f32>>;
 
 // Linear thread index for 1D work split over a 2D dispatch grid (65535-group limit).
 fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {

@@ -85,7 +85,12 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
             }
         }
     }
-    let rate = sum / heat_density(ph_i, i);
+    // The laser pass left its source (W/kg) in heat.w.
+    var source = 0.0;
+    if (P.laser.w != 0.0) {
+        source = heat[i].w;
+    }
+    let rate = source + sum / heat_density(ph_i, i);
     // Neighbours read only T (.y), so the enthalpy can be updated in place.
     var hv = heat[i];
     hv.x = hv.x + sim.dt * rate;

@@ -109,7 +109,7 @@ impl Checker {
                 let (top_liq, bottom_gas) = layer_extent(m, st);
                 self.max_penetration = self.max_penetration.max(top_liq - bottom_gas);
             }
-            CheckKind::Adiabatic => {
+            CheckKind::Adiabatic | CheckKind::LaserEnergy => {
                 self.initial_enthalpy
                     .get_or_insert(heat_checks::total_enthalpy(m, st));
             }
@@ -147,6 +147,9 @@ impl Checker {
                 heat_checks::adiabatic(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
             }
             CheckKind::Stefan1d => heat_checks::stefan_1d(m, &self.fronts, &self.front_info),
+            CheckKind::LaserEnergy => {
+                heat_checks::laser_energy(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
+            }
         };
         let pass = value.is_finite() && value <= self.tolerance;
         CheckResult {

@@ -1,7 +1,7 @@
 //! The f32 parameter block both backends read (DESIGN rule 6): computed once on the
 //! host in f64 and rounded to f32, so the CPU twin and the WGSL pass see the same bits.
 
-use crate::model::{Model, MAX_PHASES};
+use crate::model::{Model, MAX_LASER_POINTS, MAX_PHASES};
 use crate::scene::{KernelKind, PhaseKind, Slip};
 use bytemuck::{Pod, Zeroable};
 use std::f64::consts::PI;
@@ -55,6 +55,19 @@ pub struct Params {
     /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
     /// (Cleary–Monaghan regularisation), 1 for a heat scene, unused.
     pub heat: [f32; 4],
+    /// Laser: absorptivity ζ, beam radius r_w, absorption coefficient a, 1 if on.
+    pub laser: [f32; 4],
+    /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
+    /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
+    pub laser_grid: [f32; 4],
+    /// Bins per axis (1 beyond the dimension), path points + 256 × power steps.
+    pub laser_bins: [u32; 4],
+    /// Lower corner of the bin grid in grid-relative coordinates.
+    pub laser_lo: [f32; 4],
+    /// Scan path: time, lateral beam centre (grid-relative), unused.
+    pub laser_path: [[f32; 4]; MAX_LASER_POINTS],
+    /// Power schedule: time, power from then on, unused, unused.
+    pub laser_power: [[f32; 4]; MAX_LASER_POINTS],
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
@@ -174,6 +187,7 @@ impl Params {
                 0.0,
             ],
             consts: SHADER_CONSTS,
+            ..laser_block(m)
         }
     }
     pub fn n(&self) -> usize {
@@ -190,6 +204,59 @@ impl Params {
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phase_d[phase as usize][3] as u32
     }
+}
+
+/// The laser part of the block; every other field zero (filled by `Params::new`).
+fn laser_block(m: &Model) -> Params {
+    let mut p = Params::zeroed();
+    let Some(l) = &m.laser else { return p };
+    let d = m.dim as i32;
+    let dx = m.dx;
+    p.laser = [
+        l.absorptivity as f32,
+        l.radius as f32,
+        l.absorption as f32,
+        1.0,
+    ];
+    let peak = if m.dim == 3 {
+        2.0 / (PI * l.radius * l.radius)
+    } else {
+        (2.0 / PI).sqrt() / l.radius
+    };
+    p.laser_grid = [
+        dx as f32,
+        peak as f32,
+        dx.powi(d) as f32,
+        dx.powi(d - 1) as f32,
+    ];
+    let mut bins = [1u32; 4];
+    for a in 0..m.dim as usize {
+        bins[a] = ((m.domain_hi[a] - m.domain_lo[a]) / dx - 1e-9)
+            .ceil()
+            .max(1.0) as u32;
+    }
+    bins[3] = l.path.len() as u32 + 256 * l.power.len() as u32;
+    p.laser_bins = bins;
+    let lo = m.to_local(m.domain_lo);
+    p.laser_lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
+    for (k, (t, x)) in l.path.iter().enumerate() {
+        let mut abs = m.domain_lo;
+        abs[0] = x[0];
+        if m.dim == 3 {
+            abs[1] = x[1];
+        }
+        let loc = m.to_local(abs);
+        p.laser_path[k] = [
+            *t as f32,
+            loc[0] as f32,
+            if m.dim == 3 { loc[1] as f32 } else { 0.0 },
+            0.0,
+        ];
+    }
+    for (k, (t, pw)) in l.power.iter().enumerate() {
+        p.laser_power[k] = [*t as f32, *pw as f32, 0.0, 0.0];
+    }
+    p
 }
 
 fn finite_or_max(v: f64) -> f32 {

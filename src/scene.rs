@@ -87,6 +87,33 @@ pub struct SceneFile {
     pub check: Option<CheckDef>,
     #[serde(default)]
     pub watchdog: WatchdogDef,
+    pub laser: Option<LaserDef>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LaserModel {
+    /// Volumetric Beer–Lambert absorption with column binning (R18 §3.2.2).
+    BeerLambert,
+}
+
+/// A laser heat source. The beam points down the last axis (−y in 2D, −z in 3D).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LaserDef {
+    pub model: LaserModel,
+    /// Absorptivity ζ: the fraction of the beam power the material can take up.
+    pub absorptivity: f64,
+    /// Beam radius r_w (m): irradiance ∝ exp(−2 r²/r_w²), d_w = 2 r_w (F22 (17)).
+    pub radius: f64,
+    /// Beer–Lambert absorption coefficient (1/m).
+    pub absorption_coefficient: Option<f64>,
+    /// Power schedule: [time, power] pairs, each power held from its time on
+    /// (W; W per metre of depth in 2D). Before the first time the beam is off.
+    pub power: Vec<Vec<f64>>,
+    /// Scan path: [time, x] (2D) or [time, x, y] (3D) beam centres, linear in
+    /// between and held before the first and after the last.
+    pub path: Vec<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -300,6 +327,9 @@ pub enum CheckKind {
     /// One-phase Stefan problem: melting front s(t) = 2λ√(α t).
     #[serde(rename = "stefan_1d")]
     Stefan1d,
+    /// Energy balance with a laser: enthalpy gained = ζ ∫P dt − energy lost
+    /// through Dirichlet walls (none in an insulated scene).
+    LaserEnergy,
 }
 
 impl CheckKind {
@@ -315,6 +345,7 @@ impl CheckKind {
             CheckKind::ConductionTwoMaterials => "conduction_two_materials",
             CheckKind::Adiabatic => "adiabatic",
             CheckKind::Stefan1d => "stefan_1d",
+            CheckKind::LaserEnergy => "laser_energy",
         }
     }
 }

@@ -90,6 +90,16 @@ fn heat_passes_200_steps() {
     assert_bit_identical("stefan_1d", &["dx=2e-3"], 200);
     assert_bit_identical("conduction_two_materials", &[], 200);
     assert_bit_identical("adiabatic_box", &[], 200);
+    assert_bit_identical("laser_flat_plate", &[], 200);
+    // A moving beam switched off half-way.
+    assert_bit_identical(
+        "laser_flat_plate",
+        &[
+            "laser.power=[[0.0, 2.0e4], [1.0e-4, 0.0]]",
+            "laser.path=[[0.0, 1.0e-4], [2.0e-4, 3.0e-4]]",
+        ],
+        200,
+    );
 }
 
 const HOT_WATER: [&str; 4] = [

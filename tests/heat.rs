@@ -113,3 +113,24 @@ fn conduction_limit_binds_and_is_named() {
     );
     assert!(stdout.contains("conduction 1.0000e-1 s"), "{stdout}");
 }
+
+#[test]
+fn laser_flat_plate_absorbs_zeta_p_within_1_percent() {
+    let (v, pass) = check_value("laser_flat_plate", &[]);
+    assert!(pass && v <= 0.01, "{v}");
+}
+
+/// A moving beam switched off half-way: the energy balance holds to one step's
+/// energy at the switch (P Δt out of P t/2: 1/26 here, so the tolerance is 5%).
+#[test]
+fn laser_scan_path_and_power_schedule_deposit_what_the_schedule_says() {
+    let (v, pass) = check_value(
+        "laser_flat_plate",
+        &[
+            "laser.power=[[0.0, 2.0e4], [5.0e-5, 0.0]]",
+            "laser.path=[[0.0, 1.0e-4], [1.0e-4, 3.0e-4]]",
+            "check.tolerance=0.05",
+        ],
+    );
+    assert!(pass, "{v}");
+}

@@ -19,6 +19,8 @@ pub enum Stage {
     Wall,
     /// forces.wgsl: F22 (23) pressure + viscous forces, background pressure, gravity.
     Forces,
+    /// laser.wgsl: Beer–Lambert absorption with column binning; source in heat.w.
+    Laser,
     /// heat.wgsl `conduct`: conduction dh/dt and the explicit Euler enthalpy update.
     Heat,
     /// heat.wgsl `temperature`: T and liquid fraction from the enthalpy.
@@ -37,6 +39,7 @@ impl Stage {
             Stage::Density => "density",
             Stage::Wall => "wall",
             Stage::Forces => "forces",
+            Stage::Laser => "laser",
             Stage::Heat => "heat.conduct",
             Stage::Temperature => "heat.temperature",
             Stage::Kick => "integrate.kick",
@@ -56,12 +59,13 @@ impl Stage {
 /// One velocity-Verlet (kick–drift–kick) step with every stage a scene can need.
 /// Heat is explicit Euler inside the step: conduction reads the temperatures of the
 /// previous step, then the temperatures follow the new enthalpies.
-pub const STEP: [Stage; 9] = [
+pub const STEP: [Stage; 10] = [
     Stage::KickDrift,
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Forces,
+    Stage::Laser,
     Stage::Heat,
     Stage::Temperature,
     Stage::Kick,
@@ -80,11 +84,12 @@ pub const PRIME: [Stage; 6] = [
 ];
 
 /// The compute passes in the order `spatter validate` lists them.
-const PASS_ORDER: [&str; 7] = [
+const PASS_ORDER: [&str; 8] = [
     "neighbors",
     "density",
     "wall",
     "forces",
+    "laser",
     "heat",
     "integrate",
     "timestep",
@@ -108,6 +113,7 @@ impl Pipeline {
             Stage::Wall => walls && fluid,
             Stage::KickDrift | Stage::Density | Stage::Forces | Stage::Kick => fluid,
             Stage::Heat | Stage::Temperature => heat,
+            Stage::Laser => params.laser[3] != 0.0,
             Stage::Neighbors | Stage::Timestep => true,
         };
         Pipeline {

@@ -11,10 +11,12 @@
 //! conduct: for every conducting particle i (liquid, gas, solid)
 //!   dh_i/dt = (1/ρ_i) Σ_j V_j k_ij (T_i − T_j) (∇_iW_ij · r_ij)/(r_ij² + η²),
 //!   k_ij = 4 k_i k_j/(k_i + k_j) between conducting particles, 2 k_i against a
-//!   Dirichlet wall (J22 (25)); adiabatic walls and free surfaces add nothing. ∇_iW·r_ij = r dW/dr. Explicit Euler: h_i += Δt dh_i/dt
-//!   (J22 (21)). V_j = m_j/ρ_j with summation density for fluids and ρ0 for solids
-//!   and walls, which do not compress. Each pair's flux is antisymmetric, so the
-//!   total enthalpy Σ m h changes only through Dirichlet walls (up to rounding).
+//!   Dirichlet wall (J22 (25)); adiabatic walls and free surfaces add nothing.
+//!   ∇_iW·r_ij = r dW/dr. A laser source (heat.w, left by the laser pass) adds to
+//!   the rate. Explicit Euler: h_i += Δt dh_i/dt (J22 (21)). V_j = m_j/ρ_j with
+//!   summation density for fluids and ρ0 for solids and walls, which do not
+//!   compress. Each pair's flux is antisymmetric, so the total enthalpy Σ m h
+//!   changes only through Dirichlet walls and the laser (up to rounding).
 //! temperature: T(h) and f_l(h) per material, linear over the melting band.
 
 use super::neighbors::{for_each_neighbor, CellTable};
@@ -71,6 +73,8 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     wall_temperature(pr, st, grid);
     let dt = st.sim.dt;
     let eta2 = pr.heat[1];
+    // The laser pass left its source (W/kg) in heat.w.
+    let laser_on = pr.laser[3] != 0.0;
     let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let rates: Vec<f32> = (0..st.len())
         .into_par_iter()
@@ -100,7 +104,8 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
                 sum += v_j * k_ij * (t_i - heat_in[j][1]) * f;
             });
-            sum / heat_density(pr, rho, ph_i, i)
+            let source = if laser_on { heat_in[i][3] } else { 0.0 };
+            source + sum / heat_density(pr, rho, ph_i, i)
         })
         .collect();
     st.heat

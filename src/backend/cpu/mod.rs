@@ -6,6 +6,7 @@ mod density;
 mod forces;
 mod heat;
 mod integrate;
+mod laser;
 mod neighbors;
 mod timestep;
 mod wall;
@@ -20,6 +21,8 @@ pub struct CpuBackend {
     pub st: State,
     pipeline: Pipeline,
     grid: neighbors::CellTable,
+    /// Laser bins: (Σ wV, absorbed power), laser scenes only.
+    laser_bins: Vec<[f32; 2]>,
     times: Vec<(&'static str, f64)>,
 }
 
@@ -31,6 +34,7 @@ impl CpuBackend {
             pipeline,
             st,
             grid: neighbors::CellTable::default(),
+            laser_bins: Vec::new(),
             times: Vec::new(),
         }
     }
@@ -73,6 +77,11 @@ impl Backend for CpuBackend {
             Stage::Density => density::run(pr, &mut self.st, &self.grid),
             Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
             Stage::Forces => forces::run(pr, &mut self.st, &self.grid),
+            Stage::Laser => {
+                laser::bins(pr, &self.st, &self.grid, &mut self.laser_bins);
+                laser::columns(pr, self.st.sim.time, &mut self.laser_bins);
+                laser::deposit(pr, &mut self.st, &self.laser_bins);
+            }
             Stage::Heat => heat::conduct(pr, &mut self.st, &self.grid),
             Stage::Temperature => heat::temperature(pr, &mut self.st),
             Stage::Kick => integrate::kick(pr, &mut self.st),

@@ -37,9 +37,21 @@ pub fn for_each_neighbor(
     pos: &[[f32; 4]],
     grid: &CellTable,
     i: usize,
+    f: impl FnMut(usize, [f32; 3], f32),
+) {
+    for_each_near(pr, pos, grid, pos[i], f);
+}
+
+/// Visit every particle j within the support of point `pi`, in the same order as
+/// `for_each_neighbor`; `f(j, d, r2)` gets d = pi − r_j (minimum image).
+#[inline(always)]
+pub fn for_each_near(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    pi: [f32; 4],
     mut f: impl FnMut(usize, [f32; 3], f32),
 ) {
-    let pi = pos[i];
     let ci = cell_coord(pr, &pi);
     let zr = if pr.counts[2] == 3 { 1 } else { 0 };
     let flags = pr.grid[3];
@@ -57,17 +69,7 @@ pub fn for_each_neighbor(
                 };
                 let c = (cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize;
                 for j in grid.start[c] as usize..grid.end[c] as usize {
-                    let pj = pos[j];
-                    let mut d = [pi[0] - pj[0], pi[1] - pj[1], pi[2] - pj[2]];
-                    for a in 0..3 {
-                        if flags & (1 << a) != 0 {
-                            if d[a] > pr.half_period[a] {
-                                d[a] -= pr.period[a];
-                            } else if d[a] < -pr.half_period[a] {
-                                d[a] += pr.period[a];
-                            }
-                        }
-                    }
+                    let d = min_image(pr, pi, pos[j]);
                     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                     if r2 < pr.kernel[3] {
                         f(j, d, r2);
@@ -76,6 +78,22 @@ pub fn for_each_neighbor(
             }
         }
     }
+}
+
+/// d = a − b with the minimum image on periodic axes.
+#[inline(always)]
+pub fn min_image(pr: &Params, a: [f32; 4], b: [f32; 4]) -> [f32; 3] {
+    let mut d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    for k in 0..3 {
+        if pr.grid[3] & (1 << k) != 0 {
+            if d[k] > pr.half_period[k] {
+                d[k] -= pr.period[k];
+            } else if d[k] < -pr.half_period[k] {
+                d[k] += pr.period[k];
+            }
+        }
+    }
+    d
 }
 
 #[inline(always)]

@@ -18,7 +18,7 @@ const REDUCE_WG: u32 = 256;
 /// Stride between sort-stage uniforms (the usual min_uniform_buffer_offset_alignment).
 const STAGE_STRIDE: u64 = 256;
 
-const SHADERS: [(&str, &str); 7] = [
+const SHADERS: [(&str, &str); 8] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
@@ -26,13 +26,14 @@ const SHADERS: [(&str, &str); 7] = [
     ("integrate", include_str!("../../../shaders/integrate.wgsl")),
     ("timestep", include_str!("../../../shaders/timestep.wgsl")),
     ("heat", include_str!("../../../shaders/heat.wgsl")),
+    ("laser", include_str!("../../../shaders/laser.wgsl")),
 ];
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 /// Portable exp/ln/pow, prepended to every pass (twin of src/portable_math.rs).
 const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
-const ENTRY_POINTS: [(&str, &str, &str); 14] = [
+const ENTRY_POINTS: [(&str, &str, &str); 17] = [
     ("cell_keys", "neighbors", "cell_keys"),
     ("bitonic", "neighbors", "bitonic"),
     ("reorder", "neighbors", "reorder"),
@@ -47,6 +48,9 @@ const ENTRY_POINTS: [(&str, &str, &str); 14] = [
     ("wall_temperature", "heat", "wall_temperature"),
     ("conduct", "heat", "conduct"),
     ("temperature", "heat", "temperature"),
+    ("laser_bins", "laser", "laser_bins"),
+    ("laser_columns", "laser", "laser_columns"),
+    ("laser_deposit", "laser", "laser_deposit"),
 ];
 
 struct Buffers {
@@ -70,6 +74,8 @@ struct Buffers {
     /// (h, T, f_l, dh/dt) and its reorder scratch; 16-byte placeholders without heat.
     heat: wgpu::Buffer,
     s_heat: wgpu::Buffer,
+    /// Laser bins (Σ wV, absorbed power); a 16-byte placeholder without a laser.
+    bins: wgpu::Buffer,
 }
 
 pub struct GpuBackend {
@@ -165,6 +171,7 @@ impl GpuBackend {
             }),
             heat: storage(device, "heat", heat_bytes),
             s_heat: storage(device, "s_heat", heat_bytes),
+            bins: storage(device, "laser bins", laser_bin_count(&params) as u64 * 8),
         };
         let (layout, sort_layout) = layouts(device);
         let bind = main_bind_group(device, &layout, &buf);
@@ -280,6 +287,18 @@ impl GpuBackend {
         let n = self.n;
         match stage {
             Stage::Neighbors => self.encode_neighbors(enc, idx),
+            Stage::Laser => {
+                let mut pass = self.begin_pass(enc, stage, idx);
+                let p = &self.params;
+                let cols = if p.counts[2] == 3 {
+                    p.laser_bins[0] * p.laser_bins[1]
+                } else {
+                    p.laser_bins[0]
+                };
+                self.dispatch(&mut pass, "laser_bins", laser_bin_count(p));
+                self.dispatch(&mut pass, "laser_columns", cols);
+                self.dispatch(&mut pass, "laser_deposit", n);
+            }
             Stage::Heat => {
                 let mut pass = self.begin_pass(enc, stage, idx);
                 self.dispatch(&mut pass, "wall_temperature", n);
@@ -301,7 +320,9 @@ impl GpuBackend {
                     Stage::Forces => "forces",
                     Stage::Kick => "kick",
                     Stage::Temperature => "temperature",
-                    Stage::Neighbors | Stage::Timestep | Stage::Heat => unreachable!(),
+                    Stage::Neighbors | Stage::Timestep | Stage::Heat | Stage::Laser => {
+                        unreachable!()
+                    }
                 };
                 let mut pass = self.begin_pass(enc, stage, idx);
                 self.dispatch(&mut pass, name, n);
@@ -405,6 +426,14 @@ impl Profiler {
     }
 }
 
+/// Laser bins in the scene (0 without a laser).
+fn laser_bin_count(p: &Params) -> u32 {
+    if p.laser[3] == 0.0 {
+        return 0;
+    }
+    p.laser_bins[0] * p.laser_bins[1] * p.laser_bins[2]
+}
+
 /// Workgroup grid for `groups` groups: x up to 65535, the rest in y.
 fn grid_for(groups: u32) -> (u32, u32) {
     if groups <= 65535 {
@@ -440,7 +469,7 @@ fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayo
         },
         count: None,
     }];
-    for b in 1..=23 {
+    for b in 1..=24 {
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: b,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -477,7 +506,7 @@ fn main_bind_group(
     layout: &wgpu::BindGroupLayout,
     b: &Buffers,
 ) -> wgpu::BindGroup {
-    let list: [&wgpu::Buffer; 24] = [
+    let list: [&wgpu::Buffer; 25] = [
         &b.params,
         &b.pos,
         &b.vel,
@@ -502,6 +531,7 @@ fn main_bind_group(
         &b.partials,
         &b.heat,
         &b.s_heat,
+        &b.bins,
     ];
     let entries: Vec<wgpu::BindGroupEntry> = list
         .iter()

@@ -1,0 +1,169 @@
+// Beer-Lambert laser absorption with column binning (R18 §3.2.2), beam down the
+// last axis. Twin of src/backend/cpu/laser.rs (equations there).
+
+const KIND_GAS: f32 = 1.0;
+
+fn absorbs(ph: u32) -> bool {
+    return conducts(ph) && P.phase_a[ph].w != KIND_GAS;
+}
+
+fn bin_centre(k: vec3<u32>) -> vec4<f32> {
+    let dx = P.laser_grid.x;
+    return vec4<f32>(
+        P.laser_lo.x + (f32(k.x) + c_half()) * dx,
+        P.laser_lo.y + (f32(k.y) + c_half()) * dx,
+        P.laser_lo.z + (f32(k.z) + c_half()) * dx,
+        0.0);
+}
+
+// Cloud-in-cell weight of a particle offset d from a bin centre.
+fn cic(d: vec3<f32>) -> f32 {
+    let dx = P.laser_grid.x;
+    var w = 1.0;
+    for (var a = 0u; a < P.counts.z; a++) {
+        w = w * max(c_one() - abs(d[a]) / dx, 0.0);
+    }
+    return w;
+}
+
+fn n_bins() -> u32 {
+    return P.laser_bins.x * P.laser_bins.y * P.laser_bins.z;
+}
+
+@compute @workgroup_size(64)
+fn laser_bins(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let b = thread_index(gid, nwg);
+    if (b >= n_bins()) { return; }
+    let nb = P.laser_bins;
+    let c = bin_centre(vec3<u32>(b % nb.x, (b / nb.x) % nb.y, b / (nb.x * nb.y)));
+    let ci = cell_coord(c);
+    let zr = z_range();
+    var sum = 0.0;
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let d = min_image(c, pos[j]);
+                    if (len2(d) < P.kern.w && absorbs(phase[j])) {
+                        let v = mass[j] / P.phase_a[phase[j]].x;
+                        sum = sum + cic(d) * v;
+                    }
+                }
+            }
+        }
+    }
+    bins[b] = vec2<f32>(sum, 0.0);
+}
+
+fn beam_centre(t: f32) -> vec2<f32> {
+    let n = P.laser_bins.w % 256u;
+    if (t <= P.laser_path[0].x) {
+        return P.laser_path[0].yz;
+    }
+    for (var k = 1u; k < n; k++) {
+        if (t < P.laser_path[k].x) {
+            let p0 = P.laser_path[k - 1u];
+            let p1 = P.laser_path[k];
+            let f = (t - p0.x) / (p1.x - p0.x);
+            return vec2<f32>(p0.y + f * (p1.y - p0.y), p0.z + f * (p1.z - p0.z));
+        }
+    }
+    return P.laser_path[n - 1u].yz;
+}
+
+fn beam_power(t: f32) -> f32 {
+    let n = P.laser_bins.w / 256u;
+    var p = 0.0;
+    for (var k = 0u; k < n; k++) {
+        if (P.laser_power[k].x <= t) {
+            p = P.laser_power[k].y;
+        }
+    }
+    return p;
+}
+
+@compute @workgroup_size(64)
+fn laser_columns(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let c = thread_index(gid, nwg);
+    let nb = P.laser_bins;
+    let three = P.counts.z == 3u;
+    let n_cols = select(nb.x, nb.x * nb.y, three);
+    if (c >= n_cols) { return; }
+    let depth = select(nb.y, nb.z, three);
+    let stride = select(nb.x, nb.x * nb.y, three);
+    let t = sim.time;
+    let centre = beam_centre(t);
+    let power = beam_power(t);
+    let zeta = P.laser.x;
+    let rw = P.laser.y;
+    let a = P.laser.z;
+    let dx = P.laser_grid.x;
+    let top = bin_centre(vec3<u32>(c % nb.x, select(0u, c / nb.x, three), 0u));
+    let d0 = top.x - centre.x;
+    var d1 = 0.0;
+    if (three) {
+        d1 = top.y - centre.y;
+    }
+    let r2 = d0 * d0 + d1 * d1;
+    var i = zeta * power * P.laser_grid.y * pm_exp(-(c_two() * r2 / (rw * rw))) * P.laser_grid.w;
+    for (var k = i32(depth) - 1; k >= 0; k--) {
+        let b = c + u32(k) * stride;
+        let vf = bins[b].x / P.laser_grid.z;
+        let trans = pm_exp(-(a * dx * vf));
+        bins[b].y = i * (c_one() - trans);
+        i = i * trans;
+    }
+}
+
+// Bin coordinate on axis a, wrapped on periodic axes; -1 outside the grid.
+fn bin_axis(k: i32, a: u32) -> i32 {
+    let n = i32(P.laser_bins[a]);
+    if (k >= 0 && k < n) { return k; }
+    if ((P.grid.w & (1u << a)) != 0u) { return (k + n) % n; }
+    return -1;
+}
+
+@compute @workgroup_size(64)
+fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (!conducts(ph)) { return; }
+    var hv = heat[i];
+    if (!absorbs(ph)) {
+        hv.w = 0.0;
+        heat[i] = hv;
+        return;
+    }
+    let p = pos[i];
+    let v = mass[i] / P.phase_a[ph].x;
+    let dx = P.laser_grid.x;
+    let nb = P.laser_bins;
+    var k: vec3<i32>;
+    for (var a = 0u; a < 3u; a++) {
+        let f = floor((p[a] - P.laser_lo[a]) / dx);
+        k[a] = clamp(i32(f), 0, i32(nb[a]) - 1);
+    }
+    let zr = z_range();
+    var sum = 0.0;
+    for (var oz = -zr; oz <= zr; oz++) {
+        for (var oy = -1; oy <= 1; oy++) {
+            for (var ox = -1; ox <= 1; ox++) {
+                let bx = bin_axis(k.x + ox, 0u);
+                let by = bin_axis(k.y + oy, 1u);
+                let bz = bin_axis(k.z + oz, 2u);
+                if (bx < 0 || by < 0 || bz < 0) { continue; }
+                let idx = vec3<u32>(u32(bx), u32(by), u32(bz));
+                let b = idx.x + nb.x * (idx.y + nb.y * idx.z);
+                let w = cic(min_image(p, bin_centre(idx)));
+                let bv = bins[b];
+                if (w > 0.0 && bv.x > 0.0) {
+                    sum = sum + bv.y * (w * v) / bv.x;
+                }
+            }
+        }
+    }
+    hv.w = sum / mass[i];
+    heat[i] = hv;
+}

@@ -234,6 +234,18 @@ fn cmd_run(
         "steps: {}, simulated time: {:.6e} s",
         report.steps, report.sim_time
     );
+    if let Some(h) = spatter::output::heat_diagnostics(&loaded.model, &report.final_state) {
+        println!(
+            "heat: max T {:.2} K, enthalpy {:.6e} J, absorbed laser power {:.4e} W, melted volume {:.4e}, melt pool depth {:.3e} m, width {:.3e} m, length {:.3e} m",
+            h.max_temperature,
+            h.total_enthalpy,
+            h.absorbed_laser_power,
+            h.melted_volume,
+            h.pool_depth,
+            h.pool_width,
+            h.pool_length
+        );
+    }
     if profile {
         let times = backend.take_pass_times();
         let steps = report.steps.max(1) as f64;

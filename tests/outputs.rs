@@ -354,3 +354,45 @@ fn a_damaged_checkpoint_is_refused_with_its_name() {
         "{stderr}"
     );
 }
+
+/// A heat scene's frames carry temperature, liquid fraction and enthalpy, and its
+/// diagnostics the heat figures (issue 4).
+#[test]
+fn heat_fields_and_diagnostics_reach_the_mcap() {
+    let dir = scratch("outputs_heat");
+    let mcap = dir.join("s.mcap");
+    let out = spatter(&[
+        "run",
+        &common::scene("stefan_1d"),
+        "--backend",
+        "cpu",
+        "--set",
+        "dx=4e-3",
+        "--out",
+        s(&mcap),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    assert!(
+        stdout.lines().any(|l| l.starts_with("heat: max T ")),
+        "{stdout}"
+    );
+    let sum = summary(&mcap);
+    for f in ["temperature", "liquid_fraction", "enthalpy"] {
+        assert!(
+            sum["fields"].as_array().unwrap().iter().any(|v| v == f),
+            "{sum}"
+        );
+    }
+    let last = &sum["last_diagnostics"];
+    for k in [
+        "max_temperature",
+        "total_enthalpy",
+        "melted_volume",
+        "pool_depth",
+    ] {
+        assert!(last[k].as_f64().is_some(), "{k}: {last}");
+    }
+    let t_max = last["max_temperature"].as_f64().unwrap();
+    assert!(t_max > 600.0 && t_max < 700.0, "{last}");
+}

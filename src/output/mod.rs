@@ -10,6 +10,7 @@ pub mod vtk;
 
 use crate::model::Model;
 use crate::scene::PhaseKind;
+
 use crate::state::{dt_limit_name, State, DT_LIMIT_NAMES};
 use serde::Serialize;
 
@@ -118,6 +119,75 @@ pub struct Diagnostics {
     pub min_density: f64,
     pub max_density: f64,
     pub particles: std::collections::BTreeMap<String, u64>,
+    /// Heat scenes only.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub heat: Option<HeatDiagnostics>,
+}
+
+/// Heat diagnostics (issue 4). Melt pool: particles with liquid fraction ≥ ½
+/// among the liquid and solid ones; depth below the top of the condensed
+/// material, width across and length along x (3D: width along y).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct HeatDiagnostics {
+    pub max_temperature: f64,
+    /// J (per metre of depth in 2D), Σ m h over conducting particles.
+    pub total_enthalpy: f64,
+    /// ζ P(t) of the laser (W; W/m in 2D); 0 without a laser.
+    pub absorbed_laser_power: f64,
+    /// Σ f_l V over liquid and solid particles (m³; m² in 2D).
+    pub melted_volume: f64,
+    pub pool_depth: f64,
+    pub pool_width: f64,
+    pub pool_length: f64,
+}
+
+pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
+    if st.heat.is_empty() {
+        return None;
+    }
+    let up = m.dim as usize - 1;
+    let cell = m.dx.powi(m.dim as i32);
+    let mut d = HeatDiagnostics {
+        max_temperature: f64::NEG_INFINITY,
+        total_enthalpy: 0.0,
+        absorbed_laser_power: m
+            .laser
+            .as_ref()
+            .map_or(0.0, |l| l.absorptivity * l.power_at(st.sim.time as f64)),
+        melted_volume: 0.0,
+        pool_depth: 0.0,
+        pool_width: 0.0,
+        pool_length: 0.0,
+    };
+    let mut top = f64::NEG_INFINITY;
+    let mut pool = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+    for i in 0..st.len() {
+        let ph = &m.phases[st.phase[i] as usize];
+        if !ph.conducts() {
+            continue;
+        }
+        let [h, t, fl, _] = st.heat[i];
+        d.max_temperature = d.max_temperature.max(t as f64);
+        d.total_enthalpy += st.mass[i] as f64 * h as f64;
+        if ph.kind == PhaseKind::Gas {
+            continue;
+        }
+        let x: Vec<f64> = (0..3).map(|a| world_coord(m, st, i, a) as f64).collect();
+        top = top.max(x[up]);
+        d.melted_volume += fl as f64 * cell;
+        if fl >= 0.5 {
+            for a in 0..3 {
+                pool[a] = [pool[a][0].min(x[a]), pool[a][1].max(x[a])];
+            }
+        }
+    }
+    if pool[0][0].is_finite() {
+        let extent = |a: usize| pool[a][1] - pool[a][0] + m.dx;
+        d.pool_depth = top - pool[up][0] + 0.5 * m.dx;
+        d.pool_length = extent(0);
+        d.pool_width = if m.dim == 3 { extent(1) } else { 0.0 };
+    }
+    Some(d)
 }
 
 pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
@@ -132,11 +202,12 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         min_density: f64::INFINITY,
         max_density: f64::NEG_INFINITY,
         particles: m.phases.iter().map(|p| (p.name.clone(), 0)).collect(),
+        heat: heat_diagnostics(m, st),
     };
     for i in 0..st.len() {
         let phase = &m.phases[st.phase[i] as usize];
         *d.particles.entry(phase.name.clone()).or_default() += 1;
-        if phase.kind == PhaseKind::Wall {
+        if !phase.is_fluid() {
             continue;
         }
         let v = st.vel[i];
@@ -167,7 +238,7 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         .iter()
         .map(|p| (p.name.clone(), serde_json::json!({"type": "integer"})))
         .collect();
-    serde_json::json!({
+    let mut schema = serde_json::json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "spatter.Diagnostics",
         "type": "object",
@@ -187,7 +258,40 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         },
         "required": ["time", "step", "dt", "dt_limit", "kinetic_energy", "total_mass",
                      "max_speed", "min_density", "max_density", "particles"]
-    })
+    });
+    if m.is_thermal() {
+        let unit = if m.dim == 2 {
+            " per metre of depth"
+        } else {
+            ""
+        };
+        let vol = if m.dim == 2 { "m^2" } else { "m^3" };
+        let extra = [
+            ("max_temperature", "largest temperature, K".to_string()),
+            (
+                "total_enthalpy",
+                format!("sum of m h over conducting particles, J{unit}"),
+            ),
+            (
+                "absorbed_laser_power",
+                format!("absorptivity x beam power, W{unit}"),
+            ),
+            (
+                "melted_volume",
+                format!("liquid-fraction-weighted volume of liquid and solid, {vol}"),
+            ),
+            (
+                "pool_depth",
+                "melt pool depth below the top of the condensed material, m".into(),
+            ),
+            ("pool_width", "melt pool extent along y (3D), m".into()),
+            ("pool_length", "melt pool extent along x, m".into()),
+        ];
+        for (k, desc) in extra {
+            schema["properties"][k] = num(&desc);
+        }
+    }
+    schema
 }
 
 /// Simulated time in nanoseconds, the MCAP log time of a frame.

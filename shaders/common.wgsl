@@ -39,6 +39,7 @@ struct Sim {
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
 const KIND_WALL: f32 = 2.0;
+const KIND_SOLID: f32 = 3.0;
 const HEAT_DIRICHLET: u32 = 1u;
 const HEAT_MELTS: u32 = 2u;
 const HEAT_LIQUID: u32 = 4u;

@@ -124,4 +124,16 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         hv.z = f;
     }
     heat[i] = hv;
+    // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).
+    let switch_to = (flags >> 8u) & 15u;
+    if (switch_to == 0u) { return; }
+    let solid = P.phase_a[ph].w == KIND_SOLID;
+    if (solid && hv.z >= 0.5) {
+        phase[i] = switch_to - 1u;
+    } else if (!solid && hv.z < 0.5) {
+        phase[i] = switch_to - 1u;
+        vel[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        acc[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        acc_b[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
 }

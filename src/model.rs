@@ -17,6 +17,9 @@ pub struct PhaseInfo {
     /// Particle mass ρ0 Δx^d (F22 Remark 2).
     pub mass: f64,
     pub thermal: Option<Thermal>,
+    /// Phase change: the phase a solid becomes when it melts, or a liquid when it
+    /// solidifies.
+    pub switch_to: Option<usize>,
 }
 
 /// Heat properties of a phase (heat scenes only).
@@ -465,10 +468,56 @@ fn phase_table(
             velocity,
             mass: rho0 * dx.powi(dim as i32),
             thermal: None,
+            switch_to: None,
         });
     }
     thermal_table(cx, scene, &mut out)?;
+    phase_changes(cx, scene, &mut out)?;
     Ok(out)
+}
+
+/// Solid ↔ liquid pairs from `melts_into`: same material, one that melts.
+fn phase_changes(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Result<(), InputError> {
+    for s in 0..phases.len() {
+        let def = &scene.phases[&phases[s].name];
+        let Some(target) = &def.melts_into else {
+            continue;
+        };
+        let key = format!("phases.{}.melts_into", phases[s].name);
+        if phases[s].kind != PhaseKind::Solid {
+            return Err(cx.err(&key, "only solid phases melt"));
+        }
+        let Some(l) = phases.iter().position(|p| &p.name == target) else {
+            return Err(cx.err(&key, format!("no phase named `{target}`")));
+        };
+        if phases[l].kind != PhaseKind::Liquid {
+            return Err(cx.err(&key, format!("`{target}` is not a liquid phase")));
+        }
+        if phases[l].material != phases[s].material {
+            return Err(cx.err(
+                &key,
+                "the solid and the liquid must share a material (one melting band)",
+            ));
+        }
+        if phases[s].thermal.and_then(|t| t.melting).is_none() {
+            return Err(cx.err(
+                &key,
+                format!(
+                    "material `{}` has no solidus/liquidus/latent_heat",
+                    phases[s].material
+                ),
+            ));
+        }
+        if phases[l].switch_to.is_some_and(|o| o != s) {
+            return Err(cx.err(
+                &key,
+                format!("`{target}` already solidifies into another phase"),
+            ));
+        }
+        phases[s].switch_to = Some(l);
+        phases[l].switch_to = Some(s);
+    }
+    Ok(())
 }
 
 /// Heat properties: a scene is a heat scene when any phase has a temperature.

@@ -20,6 +20,9 @@ pub const KIND_SOLID: f32 = 3.0;
 pub const HEAT_DIRICHLET: u32 = 1;
 pub const HEAT_MELTS: u32 = 2;
 pub const HEAT_LIQUID: u32 = 4;
+/// Bits 8..11 of the flags: 1 + the phase this one switches to on melting or
+/// solidifying (0: none).
+pub const HEAT_SWITCH_SHIFT: u32 = 8;
 
 /// Mirrors `struct Params` in shaders/common.wgsl field for field.
 #[repr(C)]
@@ -204,6 +207,11 @@ impl Params {
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phase_d[phase as usize][3] as u32
     }
+    /// The phase a particle of `phase` switches to on melting/solidifying.
+    pub fn switch_target(&self, phase: u32) -> Option<u32> {
+        let t = (self.heat_flags(phase) >> HEAT_SWITCH_SHIFT) & 15;
+        (t > 0).then(|| t - 1)
+    }
 }
 
 /// The laser part of the block; every other field zero (filled by `Params::new`).
@@ -286,6 +294,9 @@ fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
         };
         if t.melting.is_some() {
             flags |= HEAT_MELTS;
+        }
+        if let Some(target) = ph.switch_to {
+            flags |= (target as u32 + 1) << HEAT_SWITCH_SHIFT;
         }
         let cp = t.heat_capacity;
         c[i] = [

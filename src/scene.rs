@@ -214,6 +214,10 @@ pub struct PhaseDef {
     /// on a wall phase it is a fixed (Dirichlet) temperature, and a wall phase
     /// without one is adiabatic.
     pub temperature: Option<f64>,
+    /// Solid phases: the liquid phase a particle becomes when it melts (liquid
+    /// fraction ≥ ½); it turns back into this solid, frozen in place, when it
+    /// solidifies (F22 §3.2 with a fixed substrate).
+    pub melts_into: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -134,3 +134,35 @@ fn laser_scan_path_and_power_schedule_deposit_what_the_schedule_says() {
     );
     assert!(pass, "{v}");
 }
+
+/// Issue 4: the melt block's energy balance within 1%; on the way a pool melts
+/// (solid particles become liquid) and resolidifies once the beam is off.
+#[test]
+fn melt_block_3d_energy_balance_and_resolidification() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("heat_melt_block");
+    let _ = std::fs::create_dir_all(&dir);
+    let mcap = dir.join("m.mcap");
+    let (v, pass) = check_value("melt_block_3d", &[]);
+    assert!(pass && v <= 0.01, "{v}");
+    let out = spatter(&[
+        "run",
+        "--backend",
+        "cpu",
+        &scene("melt_block_3d"),
+        "--until",
+        "4e-4",
+        "--out",
+        mcap.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{:?}", text(&out));
+    let r = common::reader(&["summary", mcap.to_str().unwrap()]);
+    let sum: serde_json::Value = serde_json::from_slice(&r.stdout).expect("summary");
+    let peak = &sum["diagnostics_max"];
+    assert!(peak["max_temperature"].as_f64().unwrap() > 1705.0, "{peak}");
+    assert!(peak["melted_volume"].as_f64().unwrap() > 0.0, "{peak}");
+    assert!(peak["pool_depth"].as_f64().unwrap() >= 5.0e-6, "{peak}");
+    // Beam off at 3e-4 s: by 4e-4 s every particle is solid again.
+    let last = &sum["last_diagnostics"];
+    assert_eq!(last["particles"]["melt"], 0, "{last}");
+    assert_eq!(last["melted_volume"].as_f64(), Some(0.0), "{last}");
+}

@@ -141,6 +141,9 @@ def summary(path):
         "diagnostics": len(diagnostics),
         "time_span": [min(times), max(times)] if times else [],
         "last_diagnostics": diagnostics[-1] if diagnostics else None,
+        "diagnostics_max": {k: max(d[k] for d in diagnostics)
+                            for k, v in (diagnostics[0].items() if diagnostics else [])
+                            if isinstance(v, (int, float))},
         "schemas": info["schemas"],
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),

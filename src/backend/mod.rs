@@ -107,7 +107,9 @@ pub struct Pipeline {
 impl Pipeline {
     pub fn for_scene(params: &Params, st: &State) -> Pipeline {
         let walls = st.phase.iter().any(|&p| params.is_wall(p));
-        let fluid = st.phase.iter().any(|&p| !params.is_wall(p));
+        // Fluid now, or later: a solid that melts becomes fluid.
+        let fluid = st.phase.iter().any(|&p| !params.is_wall(p))
+            || (0..crate::model::MAX_PHASES as u32).any(|p| params.switch_target(p).is_some());
         let heat = params.heat[2] != 0.0;
         let needed = |s: &&Stage| match **s {
             Stage::Wall => walls && fluid,

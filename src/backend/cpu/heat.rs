@@ -17,11 +17,12 @@
 //!   summation density for fluids and ρ0 for solids and walls, which do not
 //!   compress. Each pair's flux is antisymmetric, so the total enthalpy Σ m h
 //!   changes only through Dirichlet walls and the laser (up to rounding).
-//! temperature: T(h) and f_l(h) per material, linear over the melting band.
+//! temperature: T(h) and f_l(h) per material, linear over the melting band, and
+//!   the solid ↔ liquid switch at f_l = ½.
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS};
+use crate::params::{Params, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -140,13 +141,43 @@ pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     }
 }
 
+/// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a
+/// solid whose liquid fraction reaches ½ becomes its liquid phase (at rest), a
+/// liquid whose liquid fraction falls below ½ becomes its solid phase, frozen in
+/// place (velocity and accelerations zeroed).
 pub fn temperature(pr: &Params, st: &mut State) {
-    let phase = &st.phase;
-    st.heat.par_iter_mut().enumerate().for_each(|(i, hv)| {
-        if pr.conducts(phase[i]) {
-            let (t, fl) = temperature_of(pr, phase[i], hv[0]);
+    let State {
+        heat,
+        phase,
+        vel,
+        acc,
+        acc_b,
+        ..
+    } = st;
+    heat.par_iter_mut()
+        .zip(phase.par_iter_mut())
+        .zip(
+            vel.par_iter_mut()
+                .zip(acc.par_iter_mut().zip(acc_b.par_iter_mut())),
+        )
+        .for_each(|((hv, ph), (v, (a, ab)))| {
+            if !pr.conducts(*ph) {
+                return;
+            }
+            let (t, fl) = temperature_of(pr, *ph, hv[0]);
             hv[1] = t;
             hv[2] = fl;
-        }
-    });
+            let Some(target) = pr.switch_target(*ph) else {
+                return;
+            };
+            let solid = pr.phase_a[*ph as usize][3] == KIND_SOLID;
+            if solid && fl >= 0.5 {
+                *ph = target;
+            } else if !solid && fl < 0.5 {
+                *ph = target;
+                *v = [0.0; 4];
+                *a = [0.0; 4];
+                *ab = [0.0; 4];
+            }
+        });
 }

@@ -17,7 +17,8 @@ struct Params {
     phase_c: array<vec4<f32>, 8>, // heat: k, c_p, h_solidus, h_liquidus
     phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
     heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
-    laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, on (1/0)
+    laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, model
+    iface: vec4<f32>,             // interface pass: 1/kappa (surface delta normalisation), unused
     laser_grid: vec4<f32>,        // bin size, peak irradiance per watt, bin volume, column area
     laser_bins: vec4<u32>,        // bins per axis, path points + 256 * power steps
     laser_lo: vec4<f32>,          // bin grid lower corner (grid-relative)
@@ -73,6 +74,9 @@ const WG: u32 = 64u;
 @group(0) @binding(23) var<storage, read_write> s_heat: array<vec4<f32>>;
 // Laser scenes: per bin (sum of w V, absorbed power); a placeholder otherwise.
 @group(0) @binding(24) var<storage, read_write> bins: array<vec2<f32>>;
+// Interface scenes: (normal, delta) per particle, then the Shepard sums; a
+// placeholder otherwise.
+@group(0) @binding(25) var<storage, read_write> surface: array<vec4<f32>>;
 
 // Linear thread index for 1D work split over a 2D dispatch grid (65535-group limit).
 fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
@@ -111,6 +115,7 @@ fn c_one_and_half() -> f32 { return P.consts[2].z; }
 fn c_three_quarters() -> f32 { return P.consts[2].w; }
 fn c_nine_quarters() -> f32 { return P.consts[3].x; }
 fn c_four() -> f32 { return P.consts[6].w; }
+fn c_tenth() -> f32 { return P.consts[7].x; }
 
 fn p4(t: f32) -> f32 { return t * t * t * t; }
 fn p5(t: f32) -> f32 { return t * t * t * t * t; }

@@ -167,3 +167,35 @@ fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     hv.w = sum / mass[i];
     heat[i] = hv;
 }
+
+// Gaussian surface flux F22 (17): q = zeta <-n.e_l> s_l(x) delta / rho0, e_l = -e_up.
+@compute @workgroup_size(64)
+fn laser_surface(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= P.counts.x) { return; }
+    let ph = phase[i];
+    if (!conducts(ph)) { return; }
+    var hv = heat[i];
+    if (!absorbs(ph)) {
+        hv.w = 0.0;
+        heat[i] = hv;
+        return;
+    }
+    let up = P.counts.z - 1u;
+    let t = sim.time;
+    let centre = beam_centre(t);
+    let power = beam_power(t);
+    let p = pos[i];
+    let d0 = p.x - centre.x;
+    var d1 = 0.0;
+    if (up == 2u) {
+        d1 = p.y - centre.y;
+    }
+    let r2 = d0 * d0 + d1 * d1;
+    let rw = P.laser.y;
+    let irradiance = P.laser.x * power * P.laser_grid.y * pm_exp(-(c_two() * r2 / (rw * rw)));
+    let s = surface[i];
+    let cosine = max(s[up], 0.0);
+    hv.w = irradiance * cosine * s.w / P.phase_a[ph].x;
+    heat[i] = hv;
+}

@@ -38,6 +38,9 @@ pub struct Header {
     /// The heat array (h, T, f_l, dh/dt) follows `id` (heat scenes).
     #[serde(default)]
     pub heat: bool,
+    /// The interface array (2n × 4 f32) follows the heat array.
+    #[serde(default)]
+    pub surface: bool,
 }
 
 pub struct Checkpoint {
@@ -62,6 +65,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         rng_seed: m.seed,
         rng_draws_after_setup: 0,
         heat: !st.heat.is_empty(),
+        surface: !st.surface.is_empty(),
     };
     let json = serde_json::to_vec(&header).expect("checkpoint header serializes");
     let mut out = Vec::with_capacity(64 + json.len() + st.len() * 100);
@@ -80,6 +84,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         push(&mut out, v);
     }
     push(&mut out, &st.heat);
+    push(&mut out, &st.surface);
     out.extend_from_slice(bytemuck::bytes_of(&st.sim));
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -150,6 +155,9 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         phase: c.vec(n).ok_or_else(short)?,
         id: c.vec(n).ok_or_else(short)?,
         heat: c.vec(if header.heat { n } else { 0 }).ok_or_else(short)?,
+        surface: c
+            .vec(if header.surface { 2 * n } else { 0 })
+            .ok_or_else(short)?,
         sim: bytemuck::pod_read_unaligned::<Sim>(
             c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?,
         ),

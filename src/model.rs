@@ -143,6 +143,12 @@ impl Model {
             .fold(0.0, f64::max)
     }
     /// A heat scene: some phase carries a temperature.
+    /// Scenes whose physics needs interface normals and the surface delta.
+    pub fn needs_interface(&self) -> bool {
+        self.laser
+            .as_ref()
+            .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface)
+    }
     pub fn is_thermal(&self) -> bool {
         self.phases.iter().any(|p| p.thermal.is_some())
     }

@@ -24,6 +24,10 @@ pub const HEAT_LIQUID: u32 = 4;
 /// solidifying (0: none).
 pub const HEAT_SWITCH_SHIFT: u32 = 8;
 
+/// `laser.w` model codes.
+pub const LASER_BEER_LAMBERT: f32 = 1.0;
+pub const LASER_SURFACE: f32 = 2.0;
+
 /// Mirrors `struct Params` in shaders/common.wgsl field for field.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -56,10 +60,15 @@ pub struct Params {
     /// temperature in the first slot.
     pub phase_d: [[f32; 4]; MAX_PHASES],
     /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
-    /// (Cleary–Monaghan regularisation), 1 for a heat scene, unused.
+    /// (Cleary–Monaghan regularisation), 1 for a heat scene, 1 when the scene
+    /// needs interface normals (interface pass).
     pub heat: [f32; 4],
-    /// Laser: absorptivity ζ, beam radius r_w, absorption coefficient a, 1 if on.
+    /// Laser: absorptivity ζ, beam radius r_w, absorption coefficient a, model
+    /// (0 none, LASER_BEER_LAMBERT, LASER_SURFACE).
     pub laser: [f32; 4],
+    /// Interface pass: 1/κ, the normalisation of the surface delta (κ = Σ δ V per
+    /// unit area across a planar lattice surface, `surface_delta_integral`), unused.
+    pub interface: [f32; 4],
     /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
     /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
     pub laser_grid: [f32; 4],
@@ -90,7 +99,7 @@ pub const SHADER_CONSTS: [[f32; 4]; 8] = {
         [pm::EXP_C[0], pm::EXP_C[1], pm::EXP_C[2], pm::EXP_C[3]],
         [pm::EXP_C[4], pm::EXP_C[5], pm::LN_C[0], pm::LN_C[1]],
         [pm::LN_C[2], pm::LN_C[3], pm::LN_C[4], 4.0],
-        [0.0; 4],
+        [0.1, 0.0, 0.0, 0.0],
     ]
 };
 
@@ -150,7 +159,7 @@ impl Params {
         } else {
             f32::MAX
         };
-        Params {
+        let mut p = Params {
             counts: [n_particles, m.n_cells() as u32, m.dim, m.kernel.code()],
             grid: [m.grid[0], m.grid[1], m.grid[2], flags],
             cell_inv: [
@@ -187,11 +196,15 @@ impl Params {
                 finite_or_max(m.limits.conduction),
                 (0.01 * m.h * m.h) as f32,
                 if m.is_thermal() { 1.0 } else { 0.0 },
-                0.0,
+                if m.needs_interface() { 1.0 } else { 0.0 },
             ],
             consts: SHADER_CONSTS,
             ..laser_block(m)
+        };
+        if m.needs_interface() {
+            p.interface[0] = (1.0 / surface_delta_integral(&p, m.dx)) as f32;
         }
+        p
     }
     pub fn n(&self) -> usize {
         self.counts[0] as usize
@@ -214,17 +227,77 @@ impl Params {
     }
 }
 
+/// κ = ∫δ dn of the interface pass's surface delta across a planar surface of the
+/// particle lattice (spacing Δx, half-space below the surface), per unit area.
+/// The Shepard-corrected colour gradient (R18 (3.25)) overshoots the unit jump of
+/// the colour by a few percent (quintic h = Δx: 1.059, Wendland C2 1.2Δx: 1.028,
+/// cubic: 1.108, measured as absorbed laser power on a flat plate); dividing δ by
+/// κ makes a surface flux ∫ s δ dV deposit exactly s per unit area on a flat
+/// surface (F22 (17)).
+pub fn surface_delta_integral(p: &Params, dx: f64) -> f64 {
+    let dim = p.counts[2] as i64;
+    let support = (p.kernel[3] as f64).sqrt();
+    let reach = (support / dx).ceil() as i64 + 1;
+    let depth = 3 * reach;
+    let vol = dx.powi(dim as i32);
+    let lateral: Vec<[i64; 2]> = (-reach..=reach)
+        .flat_map(|a| (-reach..=reach).map(move |b| [a, b]))
+        .filter(|l| dim == 3 || l[1] == 0)
+        .collect();
+    // Offsets from a particle in layer k to every lattice site within the support.
+    let sites = |k: i64| {
+        let lat = &lateral;
+        (0..depth + reach).flat_map(move |kj| {
+            lat.iter().filter_map(move |l| {
+                let dz = (kj - k) as f64 * dx;
+                let r2 = (l[0] * l[0] + l[1] * l[1]) as f64 * dx * dx + dz * dz;
+                (r2 < support * support).then_some((kj, dz, r2.sqrt()))
+            })
+        })
+    };
+    let gamma: Vec<f64> = (0..depth + reach)
+        .map(|k| {
+            sites(k)
+                .map(|(_, _, r)| vol * crate::kernel::w(p, r as f32) as f64)
+                .sum()
+        })
+        .collect();
+    (0..depth)
+        .map(|k| {
+            let g: f64 = sites(k)
+                .filter(|s| s.2 > 0.0)
+                .map(|(kj, dz, r)| {
+                    vol * (1.0 / gamma[k as usize] + 1.0 / gamma[kj as usize])
+                        * crate::kernel::dw(p, r as f32) as f64
+                        / r
+                        * -dz
+                })
+                .sum();
+            // Layers below the normal threshold get no normal and absorb nothing.
+            if g.abs() > 0.1 * p.kernel[1] as f64 {
+                g.abs() * dx
+            } else {
+                0.0
+            }
+        })
+        .sum()
+}
+
 /// The laser part of the block; every other field zero (filled by `Params::new`).
 fn laser_block(m: &Model) -> Params {
     let mut p = Params::zeroed();
     let Some(l) = &m.laser else { return p };
     let d = m.dim as i32;
     let dx = m.dx;
+    let model = match l.model {
+        crate::scene::LaserModel::BeerLambert => LASER_BEER_LAMBERT,
+        crate::scene::LaserModel::GaussianSurface => LASER_SURFACE,
+    };
     p.laser = [
         l.absorptivity as f32,
         l.radius as f32,
         l.absorption as f32,
-        1.0,
+        model,
     ];
     let peak = if m.dim == 3 {
         2.0 / (PI * l.radius * l.radius)
@@ -308,4 +381,32 @@ fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
         d[i] = [ts as f32, tl as f32, l as f32, flags as f32];
     }
     (c, d)
+}
+
+#[cfg(test)]
+mod tests {
+    /// κ for the three kernels at their default h/Δx, as measured by the absorbed
+    /// power on a flat plate without normalisation (1.0595, 1.0284, 1.1081).
+    #[test]
+    fn surface_delta_integral_matches_the_flat_plate_measurement() {
+        let expected = [
+            ("quintic", 1.0595),
+            ("wendland_c2", 1.0284),
+            ("cubic", 1.1081),
+        ];
+        for (k, kappa) in expected {
+            let path = concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/scenarios/validation/laser_flat_plate.toml"
+            );
+            let sets = vec![
+                format!("kernel=\"{k}\""),
+                "laser.model=\"gaussian_surface\"".to_string(),
+            ];
+            let l = crate::run::load(path, &sets).unwrap();
+            let p = super::Params::new(&l.model, l.state.len() as u32);
+            let got = super::surface_delta_integral(&p, l.model.dx);
+            assert!((got - kappa).abs() < 1e-4, "{k}: {got}");
+        }
+    }
 }

@@ -95,6 +95,8 @@ pub struct SceneFile {
 pub enum LaserModel {
     /// Volumetric Beer–Lambert absorption with column binning (R18 §3.2.2).
     BeerLambert,
+    /// Gaussian flux through the surface F22 (17): ζ ⟨−n·e_l⟩ s_l(x) δ.
+    GaussianSurface,
 }
 
 /// A laser heat source. The beam points down the last axis (−y in 2D, −z in 3D).

@@ -277,6 +277,9 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     {
         return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid or solid particle (no shape of a liquid, gas or solid phase covers a lattice site)"));
     }
+    if m.needs_interface() {
+        st.surface = vec![[0.0; 4]; 2 * st.len()];
+    }
     Ok(st)
 }
 

@@ -45,6 +45,10 @@ pub struct State {
     /// Heat scenes only (empty otherwise): specific enthalpy h (J/kg), temperature
     /// T (K), liquid fraction f_l, dh/dt of the last step (W/kg).
     pub heat: Vec<[f32; 4]>,
+    /// Scenes that need interfaces only (empty otherwise), 2n entries: first the
+    /// outward unit normal and surface delta (n.xyz, δ) per particle, then the
+    /// Shepard sum Γ (in .x) the interface pass computes on the way.
+    pub surface: Vec<[f32; 4]>,
     pub sim: Sim,
 }
 
@@ -87,6 +91,7 @@ impl State {
         ]
         .into_iter()
         .chain((!self.heat.is_empty()).then(|| vec4_field("heat", &self.heat)))
+        .chain((!self.surface.is_empty()).then(|| vec4_field("surface", &self.surface)))
         .collect()
     }
 }

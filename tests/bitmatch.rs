@@ -91,6 +91,11 @@ fn heat_passes_200_steps() {
     assert_bit_identical("conduction_two_materials", &[], 200);
     assert_bit_identical("adiabatic_box", &[], 200);
     assert_bit_identical("laser_flat_plate", &[], 200);
+    assert_bit_identical(
+        "laser_flat_plate",
+        &["laser.model=\"gaussian_surface\""],
+        200,
+    );
     // A moving beam switched off half-way.
     assert_bit_identical(
         "laser_flat_plate",
@@ -122,7 +127,8 @@ fn heat_in_a_flowing_liquid_2d_200_steps() {
 }
 
 /// Issue 4: the melt block over 200 steps, through the start of melting (solid
-/// particles switching to liquid and flowing) under a laser.
+/// particles switching to liquid and flowing) under the surface laser: interface,
+/// laser, heat and phase passes.
 #[test]
 fn melt_block_3d_200_steps() {
     assert_bit_identical("melt_block_3d", &[], 200);

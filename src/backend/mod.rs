@@ -19,7 +19,10 @@ pub enum Stage {
     Wall,
     /// forces.wgsl: F22 (23) pressure + viscous forces, background pressure, gravity.
     Forces,
-    /// laser.wgsl: Beer–Lambert absorption with column binning; source in heat.w.
+    /// interface.wgsl: Shepard sum, then interface normal and surface delta.
+    Interface,
+    /// laser.wgsl: Beer–Lambert absorption with column binning, or the Gaussian
+    /// surface flux F22 (17); source (W/kg) in heat.w.
     Laser,
     /// heat.wgsl `conduct`: conduction dh/dt and the explicit Euler enthalpy update.
     Heat,
@@ -39,6 +42,7 @@ impl Stage {
             Stage::Density => "density",
             Stage::Wall => "wall",
             Stage::Forces => "forces",
+            Stage::Interface => "interface",
             Stage::Laser => "laser",
             Stage::Heat => "heat.conduct",
             Stage::Temperature => "heat.temperature",
@@ -59,12 +63,13 @@ impl Stage {
 /// One velocity-Verlet (kick–drift–kick) step with every stage a scene can need.
 /// Heat is explicit Euler inside the step: conduction reads the temperatures of the
 /// previous step, then the temperatures follow the new enthalpies.
-pub const STEP: [Stage; 10] = [
+pub const STEP: [Stage; 11] = [
     Stage::KickDrift,
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Forces,
+    Stage::Interface,
     Stage::Laser,
     Stage::Heat,
     Stage::Temperature,
@@ -84,11 +89,12 @@ pub const PRIME: [Stage; 6] = [
 ];
 
 /// The compute passes in the order `spatter validate` lists them.
-const PASS_ORDER: [&str; 8] = [
+const PASS_ORDER: [&str; 9] = [
     "neighbors",
     "density",
     "wall",
     "forces",
+    "interface",
     "laser",
     "heat",
     "integrate",
@@ -116,6 +122,7 @@ impl Pipeline {
             Stage::KickDrift | Stage::Density | Stage::Forces | Stage::Kick => fluid,
             Stage::Heat | Stage::Temperature => heat,
             Stage::Laser => params.laser[3] != 0.0,
+            Stage::Interface => params.heat[3] != 0.0,
             Stage::Neighbors | Stage::Timestep => true,
         };
         Pipeline {

@@ -14,6 +14,10 @@
 //!    wV/Σ wV of their power, as a source q = P/m (W/kg) in heat.w for the
 //!    conduction pass.
 //! Portable exp (src/portable_math.rs) keeps it bit-identical to the GPU.
+//!
+//! surface (the other model, F22 (17)): every liquid or solid particle takes
+//! q = ζ ⟨−n·e_l⟩ s_l(x) δ / ρ0 (W/kg) with the interface pass's outward normal n
+//! and surface delta δ, e_l = −e_up, s_l = P s0 exp(−2 d²/r_w²).
 
 use super::neighbors::{for_each_near, min_image, CellTable};
 use crate::params::{Params, KIND_GAS};
@@ -211,4 +215,34 @@ fn bin_at(pr: &Params, k: [i32; 3]) -> Option<[u32; 3]> {
         };
     }
     Some(out)
+}
+
+pub fn surface(pr: &Params, st: &mut State) {
+    let n = st.len();
+    let up = pr.counts[2] as usize - 1;
+    let centre = beam_centre(pr, st.sim.time);
+    let power = beam_power(pr, st.sim.time);
+    let [zeta, rw, _, _] = pr.laser;
+    let peak = pr.laser_grid[1];
+    let (pos, phase, surf) = (&st.pos, &st.phase, &st.surface);
+    let q: Vec<f32> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if !absorbs(pr, phase[i]) {
+                return 0.0;
+            }
+            let p = pos[i];
+            let d0 = p[0] - centre[0];
+            let d1 = if up == 2 { p[1] - centre[1] } else { 0.0 };
+            let r2 = d0 * d0 + d1 * d1;
+            let irradiance = zeta * power * peak * pm_exp(-(2.0 * r2 / (rw * rw)));
+            let cos = surf[i][up].max(0.0);
+            irradiance * cos * surf[i][3] / pr.phase_a[phase[i] as usize][0]
+        })
+        .collect();
+    for (i, hv) in st.heat.iter_mut().enumerate() {
+        if pr.conducts(phase[i]) {
+            hv[3] = q[i];
+        }
+    }
 }

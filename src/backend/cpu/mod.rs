@@ -6,13 +6,14 @@ mod density;
 mod forces;
 mod heat;
 mod integrate;
+mod interface;
 mod laser;
 mod neighbors;
 mod timestep;
 mod wall;
 
 use super::{Backend, Pipeline, Stage};
-use crate::params::Params;
+use crate::params::{Params, LASER_SURFACE};
 use crate::state::{Sim, State};
 use std::time::Instant;
 
@@ -77,6 +78,8 @@ impl Backend for CpuBackend {
             Stage::Density => density::run(pr, &mut self.st, &self.grid),
             Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
             Stage::Forces => forces::run(pr, &mut self.st, &self.grid),
+            Stage::Interface => interface::run(pr, &mut self.st, &self.grid),
+            Stage::Laser if pr.laser[3] == LASER_SURFACE => laser::surface(pr, &mut self.st),
             Stage::Laser => {
                 laser::bins(pr, &self.st, &self.grid, &mut self.laser_bins);
                 laser::columns(pr, self.st.sim.time, &mut self.laser_bins);

@@ -8,7 +8,7 @@ pub mod probe;
 pub use context::{AdapterChoice, GpuContext};
 
 use super::{Backend, Pipeline, Stage};
-use crate::params::Params;
+use crate::params::{Params, LASER_BEER_LAMBERT, LASER_SURFACE};
 use crate::state::{Sim, State};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
@@ -18,7 +18,7 @@ const REDUCE_WG: u32 = 256;
 /// Stride between sort-stage uniforms (the usual min_uniform_buffer_offset_alignment).
 const STAGE_STRIDE: u64 = 256;
 
-const SHADERS: [(&str, &str); 8] = [
+const SHADERS: [(&str, &str); 9] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
@@ -27,13 +27,14 @@ const SHADERS: [(&str, &str); 8] = [
     ("timestep", include_str!("../../../shaders/timestep.wgsl")),
     ("heat", include_str!("../../../shaders/heat.wgsl")),
     ("laser", include_str!("../../../shaders/laser.wgsl")),
+    ("interface", include_str!("../../../shaders/interface.wgsl")),
 ];
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 /// Portable exp/ln/pow, prepended to every pass (twin of src/portable_math.rs).
 const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
-const ENTRY_POINTS: [(&str, &str, &str); 17] = [
+const ENTRY_POINTS: [(&str, &str, &str); 20] = [
     ("cell_keys", "neighbors", "cell_keys"),
     ("bitonic", "neighbors", "bitonic"),
     ("reorder", "neighbors", "reorder"),
@@ -51,6 +52,9 @@ const ENTRY_POINTS: [(&str, &str, &str); 17] = [
     ("laser_bins", "laser", "laser_bins"),
     ("laser_columns", "laser", "laser_columns"),
     ("laser_deposit", "laser", "laser_deposit"),
+    ("laser_surface", "laser", "laser_surface"),
+    ("shepard", "interface", "shepard"),
+    ("normals", "interface", "normals"),
 ];
 
 struct Buffers {
@@ -76,6 +80,8 @@ struct Buffers {
     s_heat: wgpu::Buffer,
     /// Laser bins (Σ wV, absorbed power); a 16-byte placeholder without a laser.
     bins: wgpu::Buffer,
+    /// Interface normals and deltas, then Shepard sums (2n); placeholder otherwise.
+    surface: wgpu::Buffer,
 }
 
 pub struct GpuBackend {
@@ -172,6 +178,7 @@ impl GpuBackend {
             heat: storage(device, "heat", heat_bytes),
             s_heat: storage(device, "s_heat", heat_bytes),
             bins: storage(device, "laser bins", laser_bin_count(&params) as u64 * 8),
+            surface: storage(device, "surface", st.surface.len() as u64 * 16),
         };
         let (layout, sort_layout) = layouts(device);
         let bind = main_bind_group(device, &layout, &buf);
@@ -235,6 +242,9 @@ impl GpuBackend {
         if self.thermal() {
             q.write_buffer(&b.heat, 0, bytemuck::cast_slice(&st.heat));
         }
+        if !st.surface.is_empty() {
+            q.write_buffer(&b.surface, 0, bytemuck::cast_slice(&st.surface));
+        }
         q.submit([]);
     }
 
@@ -287,6 +297,15 @@ impl GpuBackend {
         let n = self.n;
         match stage {
             Stage::Neighbors => self.encode_neighbors(enc, idx),
+            Stage::Interface => {
+                let mut pass = self.begin_pass(enc, stage, idx);
+                self.dispatch(&mut pass, "shepard", n);
+                self.dispatch(&mut pass, "normals", n);
+            }
+            Stage::Laser if self.params.laser[3] == LASER_SURFACE => {
+                let mut pass = self.begin_pass(enc, stage, idx);
+                self.dispatch(&mut pass, "laser_surface", n);
+            }
             Stage::Laser => {
                 let mut pass = self.begin_pass(enc, stage, idx);
                 let p = &self.params;
@@ -320,9 +339,11 @@ impl GpuBackend {
                     Stage::Forces => "forces",
                     Stage::Kick => "kick",
                     Stage::Temperature => "temperature",
-                    Stage::Neighbors | Stage::Timestep | Stage::Heat | Stage::Laser => {
-                        unreachable!()
-                    }
+                    Stage::Neighbors
+                    | Stage::Timestep
+                    | Stage::Heat
+                    | Stage::Laser
+                    | Stage::Interface => unreachable!(),
                 };
                 let mut pass = self.begin_pass(enc, stage, idx);
                 self.dispatch(&mut pass, name, n);
@@ -428,7 +449,7 @@ impl Profiler {
 
 /// Laser bins in the scene (0 without a laser).
 fn laser_bin_count(p: &Params) -> u32 {
-    if p.laser[3] == 0.0 {
+    if p.laser[3] != LASER_BEER_LAMBERT {
         return 0;
     }
     p.laser_bins[0] * p.laser_bins[1] * p.laser_bins[2]
@@ -469,7 +490,7 @@ fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayo
         },
         count: None,
     }];
-    for b in 1..=24 {
+    for b in 1..=25 {
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: b,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -506,7 +527,7 @@ fn main_bind_group(
     layout: &wgpu::BindGroupLayout,
     b: &Buffers,
 ) -> wgpu::BindGroup {
-    let list: [&wgpu::Buffer; 25] = [
+    let list: [&wgpu::Buffer; 26] = [
         &b.params,
         &b.pos,
         &b.vel,
@@ -532,6 +553,7 @@ fn main_bind_group(
         &b.heat,
         &b.s_heat,
         &b.bins,
+        &b.surface,
     ];
     let entries: Vec<wgpu::BindGroupEntry> = list
         .iter()
@@ -653,6 +675,11 @@ impl Backend for GpuBackend {
             id: self.read_vec(&b.id),
             heat: if self.thermal() {
                 self.read_vec(&b.heat)
+            } else {
+                Vec::new()
+            },
+            surface: if self.params.heat[3] != 0.0 {
+                bytemuck::cast_slice(&self.read_bytes(&b.surface, 2 * self.n as u64 * 16)).to_vec()
             } else {
                 Vec::new()
             },

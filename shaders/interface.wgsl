@@ -1,0 +1,81 @@
+// Interface normal and surface delta of the condensed material, R18 (3.25)-(3.27).
+// Twin of src/backend/cpu/interface.rs (equations there). surface[i] = (n, delta),
+// surface[n + i].x = Shepard sum Gamma_i.
+
+const KIND_GAS_I: f32 = 1.0;
+
+fn condensed(ph: u32) -> bool {
+    return P.phase_a[ph].w != KIND_GAS_I;
+}
+
+fn volume(j: u32) -> f32 {
+    return mass[j] / P.phase_a[phase[j]].x;
+}
+
+@compute @workgroup_size(64)
+fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    let n = P.counts.x;
+    if (i >= n) { return; }
+    var g = 0.0;
+    if (condensed(phase[i])) {
+        let pi = pos[i];
+        let ci = cell_coord(pi);
+        let zr = z_range();
+        for (var dz = -zr; dz <= zr; dz++) {
+            for (var dy = -1; dy <= 1; dy++) {
+                for (var dx = -1; dx <= 1; dx++) {
+                    let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                    for (var j = rg.x; j < rg.y; j++) {
+                        let r2 = len2(min_image(pi, pos[j]));
+                        if (r2 < P.kern.w && condensed(phase[j])) {
+                            g = g + volume(j) * kernel_w(sqrt(r2));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    surface[n + i] = vec4<f32>(g, 0.0, 0.0, 0.0);
+}
+
+@compute @workgroup_size(64)
+fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    let n = P.counts.x;
+    if (i >= n) { return; }
+    let ph = phase[i];
+    if (!condensed(ph) || !conducts(ph)) {
+        surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        return;
+    }
+    let gamma_i = surface[n + i].x;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var g = vec3<f32>(0.0, 0.0, 0.0);
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let d = min_image(pi, pos[j]);
+                    let r2 = len2(d);
+                    if (r2 >= P.kern.w || r2 <= 0.0 || !condensed(phase[j])) { continue; }
+                    let r = sqrt(r2);
+                    let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j].x) * kernel_dw(r) / r;
+                    g.x = g.x + f * d.x;
+                    g.y = g.y + f * d.y;
+                    g.z = g.z + f * d.z;
+                }
+            }
+        }
+    }
+    let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    let scaled = delta * P.iface.x;
+    if (delta > c_tenth() * P.kern.y) {
+        surface[i] = vec4<f32>(-g.x / delta, -g.y / delta, -g.z / delta, scaled);
+    } else {
+        surface[i] = vec4<f32>(0.0, 0.0, 0.0, scaled);
+    }
+}

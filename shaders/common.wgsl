@@ -16,9 +16,11 @@ struct Params {
     phase_b: array<vec4<f32>, 8>, // wall velocity, slip
     phase_c: array<vec4<f32>, 8>, // heat: k, c_p, h_solidus, h_liquidus
     phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
+    phase_e: array<vec4<f32>, 8>, // evaporation: C_p, C_T, 1/T_v, h_v
+    phase_f: array<vec4<f32>, 8>, // T_h0, C_M, 0.82 c_s, emissivity * sigma_B
     heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
     laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, model
-    iface: vec4<f32>,             // interface pass: 1/kappa (surface delta normalisation), unused
+    iface: vec4<f32>,             // interface pass: 1/kappa (surface delta normalisation), T_ambient^4
     laser_grid: vec4<f32>,        // bin size, peak irradiance per watt, bin volume, column area
     laser_bins: vec4<u32>,        // bins per axis, path points + 256 * power steps
     laser_lo: vec4<f32>,          // bin grid lower corner (grid-relative)

@@ -90,12 +90,32 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (P.laser.w != 0.0) {
         source = heat[i].w;
     }
-    let rate = source + sum / heat_density(ph_i, i);
+    var loss = 0.0;
+    if (P.heat.w != 0.0) {
+        loss = surface_loss(ph_i, t_i, surface[i].w);
+    }
+    let rate = source - loss + sum / heat_density(ph_i, i);
     // Neighbours read only T (.y), so the enthalpy can be updated in place.
     var hv = heat[i];
     hv.x = hv.x + sim.dt * rate;
     hv.w = rate;
     heat[i] = hv;
+}
+
+// Evaporation F22 (18), (10) and radiation through the free surface, W/kg.
+fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
+    let e = P.phase_e[ph];
+    let f = P.phase_f[ph];
+    var flux = 0.0;
+    if (e.x > 0.0) {
+        let pv = e.x * pm_exp(-(e.y * (c_one() / t - e.z)));
+        let mdot = f.z * pv * sqrt(f.y / t);
+        flux = flux + mdot * (e.w + P.phase_c[ph].y * (t - f.x));
+    }
+    if (f.w > 0.0) {
+        flux = flux + f.w * (t * t * t * t - P.iface.y);
+    }
+    return flux * delta / P.phase_a[ph].x;
 }
 
 @compute @workgroup_size(64)

@@ -72,10 +72,10 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         }
     }
     let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
-    let scaled = delta * P.iface.x;
     if (delta > c_tenth() * P.kern.y) {
+        let scaled = delta * P.iface.x;
         surface[i] = vec4<f32>(-g.x / delta, -g.y / delta, -g.z / delta, scaled);
     } else {
-        surface[i] = vec4<f32>(0.0, 0.0, 0.0, scaled);
+        surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     }
 }

@@ -80,6 +80,8 @@ pub struct Checker {
     /// (t, simulated front, exact front) per sample (Stefan check), and its header.
     fronts: Vec<(f64, f64, f64)>,
     front_info: String,
+    /// (t, heat leaving through free surfaces) per sample (laser energy check).
+    losses: Vec<(f64, f64)>,
 }
 
 impl Checker {
@@ -92,6 +94,7 @@ impl Checker {
             initial_enthalpy: None,
             fronts: Vec::new(),
             front_info: String::new(),
+            losses: Vec::new(),
         })
     }
 
@@ -109,9 +112,17 @@ impl Checker {
                 let (top_liq, bottom_gas) = layer_extent(m, st);
                 self.max_penetration = self.max_penetration.max(top_liq - bottom_gas);
             }
-            CheckKind::Adiabatic | CheckKind::LaserEnergy => {
+            CheckKind::Adiabatic => {
                 self.initial_enthalpy
                     .get_or_insert(heat_checks::total_enthalpy(m, st));
+            }
+            CheckKind::LaserEnergy => {
+                self.initial_enthalpy
+                    .get_or_insert(heat_checks::total_enthalpy(m, st));
+                let (evap, rad) = crate::output::surface_loss_power(m, st);
+                if self.losses.last().is_none_or(|l| l.0 < t) {
+                    self.losses.push((t, evap + rad));
+                }
             }
             CheckKind::Stefan1d => {
                 if let Some((front, exact, info)) = heat_checks::stefan_fronts(m, st) {
@@ -147,9 +158,12 @@ impl Checker {
                 heat_checks::adiabatic(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
             }
             CheckKind::Stefan1d => heat_checks::stefan_1d(m, &self.fronts, &self.front_info),
-            CheckKind::LaserEnergy => {
-                heat_checks::laser_energy(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
-            }
+            CheckKind::LaserEnergy => heat_checks::laser_energy(
+                m,
+                st,
+                self.initial_enthalpy.unwrap_or(f64::NAN),
+                &self.losses,
+            ),
         };
         let pass = value.is_finite() && value <= self.tolerance;
         CheckResult {

@@ -236,10 +236,12 @@ fn cmd_run(
     );
     if let Some(h) = spatter::output::heat_diagnostics(&loaded.model, &report.final_state) {
         println!(
-            "heat: max T {:.2} K, enthalpy {:.6e} J, absorbed laser power {:.4e} W, melted volume {:.4e}, melt pool depth {:.3e} m, width {:.3e} m, length {:.3e} m",
+            "heat: max T {:.2} K, enthalpy {:.6e} J, absorbed laser power {:.4e} W, evaporated {:.4e} W, radiated {:.4e} W, melted volume {:.4e}, melt pool depth {:.3e} m, width {:.3e} m, length {:.3e} m",
             h.max_temperature,
             h.total_enthalpy,
             h.absorbed_laser_power,
+            h.evaporated_power,
+            h.radiated_power,
             h.melted_volume,
             h.pool_depth,
             h.pool_width,

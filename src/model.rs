@@ -31,6 +31,34 @@ pub struct Thermal {
     pub heat_capacity: f64,
     /// (solidus, liquidus, latent heat) when the material melts.
     pub melting: Option<(f64, f64, f64)>,
+    /// Surface losses (liquid and solid free surfaces).
+    pub evaporation: Option<Evaporation>,
+    pub emissivity: f64,
+}
+
+/// F22 (10), (18) constants, validated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaporation {
+    pub pressure_constant: f64,
+    pub temperature_constant: f64,
+    pub boiling_temperature: f64,
+    pub latent_heat: f64,
+    pub enthalpy_reference: f64,
+    pub vapor_constant: f64,
+    pub sticking: f64,
+}
+
+impl Evaporation {
+    /// Recoil pressure p_v(T) F22 (10).
+    pub fn pressure(&self, t: f64) -> f64 {
+        self.pressure_constant
+            * (-self.temperature_constant * (1.0 / t - 1.0 / self.boiling_temperature)).exp()
+    }
+    /// Heat lost per unit area, ṁ (h_v + c_p (T − T_h0)) F22 (18).
+    pub fn flux(&self, t: f64, cp: f64) -> f64 {
+        let mdot = 0.82 * self.sticking * self.pressure(t) * (self.vapor_constant / t).sqrt();
+        mdot * (self.latent_heat + cp * (t - self.enthalpy_reference))
+    }
 }
 
 impl Thermal {
@@ -112,6 +140,7 @@ pub struct Model {
     pub gravity: [f64; 3],
     pub background_pressure: f64,
     pub pressure_floor: bool,
+    pub ambient_temperature: f64,
     pub jitter: f64,
     pub seed: u64,
     pub phases: Vec<PhaseInfo>,
@@ -143,11 +172,20 @@ impl Model {
             .fold(0.0, f64::max)
     }
     /// A heat scene: some phase carries a temperature.
-    /// Scenes whose physics needs interface normals and the surface delta.
+    /// Scenes whose physics needs interface normals and the surface delta: the
+    /// surface laser and surface losses (evaporation, radiation).
     pub fn needs_interface(&self) -> bool {
-        self.laser
+        let surface_laser = self
+            .laser
             .as_ref()
-            .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface)
+            .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface);
+        surface_laser || self.has_surface_losses()
+    }
+    pub fn has_surface_losses(&self) -> bool {
+        self.phases
+            .iter()
+            .filter_map(|p| p.thermal)
+            .any(|t| t.evaporation.is_some() || t.emissivity > 0.0)
     }
     pub fn is_thermal(&self) -> bool {
         self.phases.iter().any(|p| p.thermal.is_some())
@@ -373,6 +411,8 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         wall_layers,
         gravity,
         background_pressure: sim.background_pressure,
+        ambient_temperature: cx
+            .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
         pressure_floor: sim.pressure_floor,
         jitter: sim.jitter,
         seed: sim.seed,
@@ -555,6 +595,8 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
                 conductivity: 0.0,
                 heat_capacity: 0.0,
                 melting: None,
+                evaporation: None,
+                emissivity: 0.0,
             });
             continue;
         }
@@ -585,11 +627,39 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
                 ))
             }
         };
+        let evaporation = match &mat.evaporation {
+            None => None,
+            Some(_) if ph.kind != PhaseKind::Liquid => None,
+            Some(e) => {
+                let k = |n: &str| mkey(&format!("evaporation.{n}"));
+                Some(Evaporation {
+                    pressure_constant: cx.positive(&k("pressure_constant"), e.pressure_constant)?,
+                    temperature_constant: cx
+                        .positive(&k("temperature_constant"), e.temperature_constant)?,
+                    boiling_temperature: cx
+                        .positive(&k("boiling_temperature"), e.boiling_temperature)?,
+                    latent_heat: cx.positive(&k("latent_heat"), e.latent_heat)?,
+                    enthalpy_reference: cx
+                        .non_negative(&k("enthalpy_reference"), e.enthalpy_reference)?,
+                    vapor_constant: cx.positive(&k("vapor_constant"), e.vapor_constant)?,
+                    sticking: cx.positive(&k("sticking"), e.sticking)?,
+                })
+            }
+        };
+        let emissivity = match mat.emissivity {
+            Some(e) if !(0.0..=1.0).contains(&e) => {
+                return Err(cx.err(&mkey("emissivity"), format!("must lie in [0, 1] (got {e})")))
+            }
+            Some(e) => e,
+            None => 0.0,
+        };
         ph.thermal = Some(Thermal {
             temperature: t,
             conductivity,
             heat_capacity,
             melting,
+            evaporation,
+            emissivity,
         });
     }
     Ok(())

@@ -59,6 +59,11 @@ pub struct Params {
     /// (HEAT_DIRICHLET, HEAT_MELTS, HEAT_LIQUID). A Dirichlet wall keeps its fixed
     /// temperature in the first slot.
     pub phase_d: [[f32; 4]; MAX_PHASES],
+    /// Surface losses per phase: evaporation C_p (Pa), C_T (K), 1/T_v (1/K), h_v (J/kg)
+    /// (all 0 without evaporation).
+    pub phase_e: [[f32; 4]; MAX_PHASES],
+    /// Surface losses per phase: T_h0 (K), C_M, 0.82 c_s, ε σ_B (radiation).
+    pub phase_f: [[f32; 4]; MAX_PHASES],
     /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
     /// (Cleary–Monaghan regularisation), 1 for a heat scene, 1 when the scene
     /// needs interface normals (interface pass).
@@ -67,7 +72,8 @@ pub struct Params {
     /// (0 none, LASER_BEER_LAMBERT, LASER_SURFACE).
     pub laser: [f32; 4],
     /// Interface pass: 1/κ, the normalisation of the surface delta (κ = Σ δ V per
-    /// unit area across a planar lattice surface, `surface_delta_integral`), unused.
+    /// unit area across a planar lattice surface, `surface_delta_integral`);
+    /// T_ambient⁴ for radiation; unused; unused.
     pub interface: [f32; 4],
     /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
     /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
@@ -154,6 +160,7 @@ impl Params {
             ];
         }
         let (phase_c, phase_d) = heat_tables(m);
+        let (phase_e, phase_f) = loss_tables(m);
         let viscous = if m.limits.viscous.is_finite() {
             m.limits.viscous as f32
         } else {
@@ -192,6 +199,8 @@ impl Params {
             phase_b,
             phase_c,
             phase_d,
+            phase_e,
+            phase_f,
             heat: [
                 finite_or_max(m.limits.conduction),
                 (0.01 * m.h * m.h) as f32,
@@ -203,6 +212,7 @@ impl Params {
         };
         if m.needs_interface() {
             p.interface[0] = (1.0 / surface_delta_integral(&p, m.dx)) as f32;
+            p.interface[1] = m.ambient_temperature.powi(4) as f32;
         }
         p
     }
@@ -346,6 +356,30 @@ fn finite_or_max(v: f64) -> f32 {
     } else {
         f32::MAX
     }
+}
+
+/// Stefan–Boltzmann constant (W m⁻² K⁻⁴).
+const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
+
+fn loss_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
+    let mut e = [[0.0f32; 4]; MAX_PHASES];
+    let mut f = [[0.0f32; 4]; MAX_PHASES];
+    for (i, ph) in m.phases.iter().enumerate() {
+        let Some(t) = ph.thermal else { continue };
+        if let Some(v) = t.evaporation {
+            e[i] = [
+                v.pressure_constant as f32,
+                v.temperature_constant as f32,
+                (1.0 / v.boiling_temperature) as f32,
+                v.latent_heat as f32,
+            ];
+            f[i][0] = v.enthalpy_reference as f32;
+            f[i][1] = v.vapor_constant as f32;
+            f[i][2] = (0.82 * v.sticking) as f32;
+        }
+        f[i][3] = (t.emissivity * STEFAN_BOLTZMANN) as f32;
+    }
+    (e, f)
 }
 
 fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {

@@ -143,6 +143,13 @@ pub struct Simulation {
     pub jitter: f64,
     #[serde(default = "default_seed")]
     pub seed: u64,
+    /// Temperature of the surroundings for radiation loss (K).
+    #[serde(default = "default_ambient")]
+    pub ambient_temperature: f64,
+}
+
+fn default_ambient() -> f64 {
+    300.0
 }
 
 fn default_formulation() -> Formulation {
@@ -201,6 +208,37 @@ pub struct Material {
     pub solidus: Option<f64>,
     pub liquidus: Option<f64>,
     pub latent_heat: Option<f64>,
+    /// Evaporation heat loss F22 (18) with the recoil-pressure law F22 (10), liquid
+    /// phases at a free surface.
+    pub evaporation: Option<EvaporationDef>,
+    /// Radiation loss σ ε (T⁴ − T_ambient⁴) from free surfaces (R18 (3.39)).
+    pub emissivity: Option<f64>,
+}
+
+/// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),
+/// loss per area ṁ (h_v + c_p (T − T_h0)).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvaporationDef {
+    /// C_p (Pa).
+    pub pressure_constant: f64,
+    /// C_T (K).
+    pub temperature_constant: f64,
+    /// T_v (K).
+    pub boiling_temperature: f64,
+    /// h_v (J/kg).
+    pub latent_heat: f64,
+    /// T_h0 (K), reference temperature of the vapour's specific enthalpy.
+    pub enthalpy_reference: f64,
+    /// C_M = M/(2πR) (K s²/m²).
+    pub vapor_constant: f64,
+    /// c_s, close to one for metals.
+    #[serde(default = "one")]
+    pub sticking: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -96,6 +96,16 @@ fn heat_passes_200_steps() {
         &["laser.model=\"gaussian_surface\""],
         200,
     );
+    // Radiation through the free surface of a hot plate.
+    assert_bit_identical(
+        "laser_flat_plate",
+        &[
+            "laser.model=\"gaussian_surface\"",
+            "materials.steel.emissivity=0.8",
+            "phases.plate.temperature=1800.0",
+        ],
+        200,
+    );
     // A moving beam switched off half-way.
     assert_bit_identical(
         "laser_flat_plate",

@@ -178,3 +178,41 @@ fn melt_block_3d_energy_balance_and_resolidification() {
     assert_eq!(last["particles"]["melt"], 0, "{last}");
     assert_eq!(last["melted_volume"].as_f64(), Some(0.0), "{last}");
 }
+
+/// Radiation from the free surface of a hot plate (beam off): the enthalpy lost
+/// equals σ ε (T⁴ − T_a⁴) integrated over the surface and time, and the power is
+/// within 2% of the flat-surface value σ (T⁴ − T_a⁴) × width (the two corner
+/// columns next to the side walls radiate less).
+#[test]
+fn radiation_loss_balances_and_matches_the_flat_surface_flux() {
+    let sets = [
+        "laser.power=[[0.0, 0.0]]",
+        "phases.plate.temperature=2000.0",
+        "materials.steel.emissivity=1.0",
+        "laser.model=\"gaussian_surface\"",
+    ];
+    let (v, pass) = check_value("laser_flat_plate", &sets);
+    assert!(pass && v <= 0.01, "{v}");
+    let path = scene("laser_flat_plate");
+    let mut args = vec!["run", "--backend", "cpu", path.as_str(), "--steps", "1"];
+    for s in &sets {
+        args.extend_from_slice(&["--set", s]);
+    }
+    let out = spatter(&args);
+    let (stdout, _) = text(&out);
+    let line = stdout.lines().find(|l| l.starts_with("heat: ")).unwrap();
+    let radiated: f64 = line
+        .split("radiated ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let ideal = 5.670374419e-8 * (2000f64.powi(4) - 300f64.powi(4)) * 4.0e-4;
+    assert!(
+        (radiated / ideal - 1.0).abs() < 0.02,
+        "{radiated} vs {ideal}"
+    );
+}

@@ -79,11 +79,12 @@ pub const STEP: [Stage; 11] = [
 
 /// Run once before the first step: accelerations, temperatures and Δt of the
 /// initial state.
-pub const PRIME: [Stage; 6] = [
+pub const PRIME: [Stage; 7] = [
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Forces,
+    Stage::Interface,
     Stage::Temperature,
     Stage::Timestep,
 ];

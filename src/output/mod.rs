@@ -139,6 +139,34 @@ pub struct HeatDiagnostics {
     pub pool_depth: f64,
     pub pool_width: f64,
     pub pool_length: f64,
+    /// Heat leaving through free surfaces by evaporation F22 (18) (W; W/m in 2D).
+    pub evaporated_power: f64,
+    /// Heat leaving through free surfaces by radiation (W; W/m in 2D).
+    pub radiated_power: f64,
+}
+
+/// (evaporated, radiated) power through free surfaces, host-side in f64 from the
+/// temperatures and surface deltas of the state.
+pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
+    if st.surface.is_empty() {
+        return (0.0, 0.0);
+    }
+    let (mut evap, mut rad) = (0.0, 0.0);
+    let ta4 = m.ambient_temperature.powi(4);
+    const SIGMA: f64 = 5.670374419e-8;
+    for i in 0..st.len() {
+        let ph = &m.phases[st.phase[i] as usize];
+        let Some(th) = ph.thermal.filter(|_| ph.conducts()) else {
+            continue;
+        };
+        let t = st.heat[i][1] as f64;
+        let area = st.surface[i][3] as f64 * st.mass[i] as f64 / ph.rho0;
+        if let Some(e) = th.evaporation {
+            evap += e.flux(t, th.heat_capacity) * area;
+        }
+        rad += th.emissivity * SIGMA * (t.powi(4) - ta4) * area;
+    }
+    (evap, rad)
 }
 
 pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
@@ -158,7 +186,10 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         pool_depth: 0.0,
         pool_width: 0.0,
         pool_length: 0.0,
+        evaporated_power: 0.0,
+        radiated_power: 0.0,
     };
+    (d.evaporated_power, d.radiated_power) = surface_loss_power(m, st);
     let mut top = f64::NEG_INFINITY;
     let mut pool = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
     for i in 0..st.len() {
@@ -286,6 +317,11 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             ),
             ("pool_width", "melt pool extent along y (3D), m".into()),
             ("pool_length", "melt pool extent along x, m".into()),
+            (
+                "evaporated_power",
+                format!("evaporation heat loss, W{unit}"),
+            ),
+            ("radiated_power", format!("radiation heat loss, W{unit}")),
         ];
         for (k, desc) in extra {
             schema["properties"][k] = num(&desc);

@@ -13,7 +13,7 @@
 //!   k_ij = 4 k_i k_j/(k_i + k_j) between conducting particles, 2 k_i against a
 //!   Dirichlet wall (J22 (25)); adiabatic walls and free surfaces add nothing.
 //!   ∇_iW·r_ij = r dW/dr. A laser source (heat.w, left by the laser pass) adds to
-//!   the rate. Explicit Euler: h_i += Δt dh_i/dt (J22 (21)). V_j = m_j/ρ_j with
+//!   the rate, surface losses (evaporation, radiation; `surface_loss`) subtract. Explicit Euler: h_i += Δt dh_i/dt (J22 (21)). V_j = m_j/ρ_j with
 //!   summation density for fluids and ρ0 for solids and walls, which do not
 //!   compress. Each pair's flux is antisymmetric, so the total enthalpy Σ m h
 //!   changes only through Dirichlet walls and the laser (up to rounding).
@@ -23,6 +23,7 @@
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
 use crate::params::{Params, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID};
+use crate::portable_math::exp as pm_exp;
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -76,6 +77,8 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     let eta2 = pr.heat[1];
     // The laser pass left its source (W/kg) in heat.w.
     let laser_on = pr.laser[3] != 0.0;
+    let surface_on = pr.heat[3] != 0.0;
+    let surf = &st.surface;
     let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let rates: Vec<f32> = (0..st.len())
         .into_par_iter()
@@ -106,7 +109,12 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 sum += v_j * k_ij * (t_i - heat_in[j][1]) * f;
             });
             let source = if laser_on { heat_in[i][3] } else { 0.0 };
-            source + sum / heat_density(pr, rho, ph_i, i)
+            let loss = if surface_on {
+                surface_loss(pr, ph_i, t_i, surf[i][3])
+            } else {
+                0.0
+            };
+            source - loss + sum / heat_density(pr, rho, ph_i, i)
         })
         .collect();
     st.heat
@@ -119,6 +127,25 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 hv[3] = rate;
             }
         });
+}
+
+/// Heat lost through the free surface per unit mass (W/kg): evaporation F22 (18)
+/// with p_v F22 (10), ṁ (h_v + c_p (T − T_h0)), plus radiation ε σ_B (T⁴ − T_a⁴),
+/// both per unit area, times the surface delta δ and divided by ρ0.
+#[inline(always)]
+pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
+    let e = pr.phase_e[phase as usize];
+    let f = pr.phase_f[phase as usize];
+    let mut flux = 0.0f32;
+    if e[0] > 0.0 {
+        let pv = e[0] * pm_exp(-(e[1] * (1.0 / t - e[2])));
+        let mdot = f[2] * pv * (f[1] / t).sqrt();
+        flux += mdot * (e[3] + pr.phase_c[phase as usize][1] * (t - f[0]));
+    }
+    if f[3] > 0.0 {
+        flux += f[3] * (t * t * t * t - pr.interface[1]);
+    }
+    flux * delta / pr.phase_a[phase as usize][0]
 }
 
 /// Temperature and liquid fraction of enthalpy h for a phase.

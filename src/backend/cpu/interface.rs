@@ -4,7 +4,9 @@
 //! works at a free surface without gas particles:
 //!   Γ_i = Σ_j V_j W_ij,
 //!   g_i = Σ_j V_j (1/Γ_i + 1/Γ_j) ∇_iW_ij        (c = 1 inside, 0 outside),
-//!   δ_i = |g_i|/κ,  n_i = −g_i/|g_i| (outward) where |g_i| > 0.1/h, else n = 0,
+//!   δ_i = |g_i|/κ,  n_i = −g_i/|g_i| (outward) where |g_i| > 0.1/h, else n = 0
+//!   and δ = 0 (F22 (20)'s tolerance: such particles are not at the interface, and
+//!   surface fluxes must not reach them),
 //! κ the planar-lattice normalisation (params::surface_delta_integral),
 //! over condensed neighbours j, V = m/ρ0. Stored for liquid and solid particles.
 
@@ -57,11 +59,11 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                 }
             });
             let delta = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-            let scaled = delta * pr.interface[0];
             if delta > 0.1 * inv_h {
+                let scaled = delta * pr.interface[0];
                 [-g[0] / delta, -g[1] / delta, -g[2] / delta, scaled]
             } else {
-                [0.0, 0.0, 0.0, scaled]
+                [0.0; 4]
             }
         })
         .collect();

@@ -158,6 +158,7 @@ impl Checker {
                 heat_checks::adiabatic(m, st, self.initial_enthalpy.unwrap_or(f64::NAN))
             }
             CheckKind::Stefan1d => heat_checks::stefan_1d(m, &self.fronts, &self.front_info),
+            CheckKind::Rosenthal => heat_checks::rosenthal(m, st),
             CheckKind::LaserEnergy => heat_checks::laser_energy(
                 m,
                 st,

@@ -826,14 +826,15 @@ fn laser(
         ));
     }
     let radius = cx.positive("laser.radius", l.radius)?;
-    let absorption = match l.absorption_coefficient {
-        Some(a) => cx.positive("laser.absorption_coefficient", a)?,
-        None => {
+    let absorption = match (l.model, l.absorption_coefficient) {
+        (_, Some(a)) => cx.positive("laser.absorption_coefficient", a)?,
+        (crate::scene::LaserModel::BeerLambert, None) => {
             return Err(cx.err(
                 "laser.absorption_coefficient",
                 "missing: the beer_lambert model needs it (1/m)",
             ))
         }
+        (crate::scene::LaserModel::GaussianSurface, None) => 0.0,
     };
     let points =
         |key: &str, list: &Vec<Vec<f64>>, width: usize| -> Result<Vec<Vec<f64>>, InputError> {

@@ -374,6 +374,8 @@ pub enum CheckKind {
     /// Energy balance with a laser: enthalpy gained = ζ ∫P dt − energy lost
     /// through Dirichlet walls (none in an insulated scene).
     LaserEnergy,
+    /// Quasi-steady temperature around a moving source on a plate (Rosenthal).
+    Rosenthal,
 }
 
 impl CheckKind {
@@ -390,6 +392,7 @@ impl CheckKind {
             CheckKind::Adiabatic => "adiabatic",
             CheckKind::Stefan1d => "stefan_1d",
             CheckKind::LaserEnergy => "laser_energy",
+            CheckKind::Rosenthal => "rosenthal",
         }
     }
 }

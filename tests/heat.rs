@@ -216,3 +216,11 @@ fn radiation_loss_balances_and_matches_the_flat_surface_flux() {
         "{radiated} vs {ideal}"
     );
 }
+
+/// Issue 4: a moving source over a plate, conduction only, against Rosenthal's
+/// quasi-steady solution (window and normalisation in heat_checks::rosenthal).
+#[test]
+fn rosenthal_scan_line_within_5_percent() {
+    let (v, pass) = check_value("rosenthal_2d", &[]);
+    assert!(pass && v <= 0.05, "{v}");
+}

@@ -18,6 +18,7 @@ struct Params {
     phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
     phase_e: array<vec4<f32>, 8>, // evaporation: C_p, C_T, 1/T_v, h_v
     phase_f: array<vec4<f32>, 8>, // T_h0, C_M, 0.82 c_s, emissivity * sigma_B
+    phase_g: array<vec4<f32>, 8>, // mushy-zone sink C (1/s), unused
     heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
     laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, model
     iface: vec4<f32>,             // interface pass: 1/kappa (surface delta normalisation), T_ambient^4

@@ -37,5 +37,13 @@ fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var c = 0u; c < 3u; c++) {
         v[c] = v[c] + hdt * a[c];
     }
+    // Mushy-zone sink J22 (12): v / (1 + dt C (1 - f_l)), semi-implicit.
+    let sink = P.phase_g[phase[i]].x;
+    if (sink > 0.0) {
+        let damp = c_one() + sim.dt * sink * (c_one() - heat[i].z);
+        for (var c = 0u; c < 3u; c++) {
+            v[c] = v[c] / damp;
+        }
+    }
     vel[i] = v;
 }

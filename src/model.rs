@@ -34,6 +34,8 @@ pub struct Thermal {
     /// Surface losses (liquid and solid free surfaces).
     pub evaporation: Option<Evaporation>,
     pub emissivity: f64,
+    /// Mushy-zone sink C (1/s), 0 for none.
+    pub mushy_damping: f64,
 }
 
 /// F22 (10), (18) constants, validated.
@@ -597,6 +599,7 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
                 melting: None,
                 evaporation: None,
                 emissivity: 0.0,
+                mushy_damping: 0.0,
             });
             continue;
         }
@@ -653,6 +656,16 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
             Some(e) => e,
             None => 0.0,
         };
+        let mushy_damping = match mat.mushy_damping {
+            Some(_) if melting.is_none() => {
+                return Err(cx.err(
+                    &mkey("mushy_damping"),
+                    "needs a melting band (solidus, liquidus, latent_heat)",
+                ));
+            }
+            Some(c) => cx.non_negative(&mkey("mushy_damping"), c)?,
+            None => 0.0,
+        };
         ph.thermal = Some(Thermal {
             temperature: t,
             conductivity,
@@ -660,6 +673,7 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
             melting,
             evaporation,
             emissivity,
+            mushy_damping,
         });
     }
     Ok(())

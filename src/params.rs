@@ -64,6 +64,8 @@ pub struct Params {
     pub phase_e: [[f32; 4]; MAX_PHASES],
     /// Surface losses per phase: T_h0 (K), C_M, 0.82 c_s, ε σ_B (radiation).
     pub phase_f: [[f32; 4]; MAX_PHASES],
+    /// Per phase: mushy-zone sink C (1/s, liquids), unused ×3.
+    pub phase_g: [[f32; 4]; MAX_PHASES],
     /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
     /// (Cleary–Monaghan regularisation), 1 for a heat scene, 1 when the scene
     /// needs interface normals (interface pass).
@@ -161,6 +163,12 @@ impl Params {
         }
         let (phase_c, phase_d) = heat_tables(m);
         let (phase_e, phase_f) = loss_tables(m);
+        let mut phase_g = [[0.0f32; 4]; MAX_PHASES];
+        for (i, ph) in m.phases.iter().enumerate() {
+            if let Some(t) = ph.thermal.filter(|_| ph.kind == PhaseKind::Liquid) {
+                phase_g[i][0] = t.mushy_damping as f32;
+            }
+        }
         let viscous = if m.limits.viscous.is_finite() {
             m.limits.viscous as f32
         } else {
@@ -201,6 +209,7 @@ impl Params {
             phase_d,
             phase_e,
             phase_f,
+            phase_g,
             heat: [
                 finite_or_max(m.limits.conduction),
                 (0.01 * m.h * m.h) as f32,

@@ -213,6 +213,10 @@ pub struct Material {
     pub evaporation: Option<EvaporationDef>,
     /// Radiation loss σ ε (T⁴ − T_ambient⁴) from free surfaces (R18 (3.39)).
     pub emissivity: Option<f64>,
+    /// Mushy-zone momentum sink C (1/s), J22 (11)–(13): a liquid particle's velocity
+    /// is divided by 1 + Δt C (1 − f_l) each step, so the melt stiffens as it
+    /// solidifies.
+    pub mushy_damping: Option<f64>,
 }
 
 /// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),

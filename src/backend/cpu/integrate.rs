@@ -36,9 +36,13 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
         });
 }
 
+/// Second half kick, then the mushy-zone sink of J22 (11)–(13) for liquids in a
+/// melting band: v ← v / (1 + Δt C (1 − f_l)), semi-implicit so a large C only
+/// stops the particle, never reverses it.
 pub fn kick(pr: &Params, st: &mut State) {
-    let hdt = 0.5 * st.sim.dt;
-    let (acc, phase) = (&st.acc, &st.phase);
+    let dt = st.sim.dt;
+    let hdt = 0.5 * dt;
+    let (acc, phase, heat) = (&st.acc, &st.phase, &st.heat);
     st.vel.par_iter_mut().enumerate().for_each(|(i, v)| {
         if pr.is_wall(phase[i]) {
             return;
@@ -47,5 +51,43 @@ pub fn kick(pr: &Params, st: &mut State) {
         for c in 0..3 {
             v[c] += hdt * a[c];
         }
+        let sink = pr.phase_g[phase[i] as usize][0];
+        if sink > 0.0 {
+            let damp = 1.0 + dt * sink * (1.0 - heat[i][2]);
+            for c in v.iter_mut().take(3) {
+                *c /= damp;
+            }
+        }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::params::Params;
+
+    /// J22 (12): with no force, a liquid particle at liquid fraction f_l leaves the
+    /// kick with v / (1 + Δt C (1 − f_l)); fully liquid particles keep v.
+    #[test]
+    fn mushy_sink_divides_velocity_by_the_semi_implicit_factor() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/melt_block_3d.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        let pr = Params::new(&l.model, l.state.len() as u32);
+        let melt = l.model.phase_index("melt").unwrap() as u32;
+        let mut st = l.state.clone();
+        st.sim.dt = 5.0e-7;
+        for (k, fl) in [(0usize, 0.5f32), (1, 1.0)] {
+            st.phase[k] = melt;
+            st.vel[k] = [1.0, -2.0, 0.5, 0.0];
+            st.acc[k] = [0.0; 4];
+            st.heat[k][2] = fl;
+        }
+        super::kick(&pr, &mut st);
+        let damp = 1.0 + 5.0e-7f32 * 1.0e6 * 0.5;
+        assert_eq!(st.vel[0][0], 1.0 / damp);
+        assert_eq!(st.vel[0][1], -2.0 / damp);
+        assert_eq!(st.vel[1], [1.0, -2.0, 0.5, 0.0]);
+    }
 }

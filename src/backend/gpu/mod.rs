@@ -194,7 +194,12 @@ impl GpuBackend {
                 }),
             }],
         });
+        // A shader the driver rejects is an error of this run, not a panic.
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let pipelines = build_pipelines(device, &layout, &sort_layout);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(format!("GPU pipeline creation failed: {e}"));
+        }
         let profiler = if profile
             && ctx
                 .device

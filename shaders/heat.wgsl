@@ -1,6 +1,12 @@
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
+// Conductivity at liquid fraction fl, linear between the solid and liquid values.
+fn conductivity(ph: u32, fl: f32) -> f32 {
+    let ks = P.phase_c[ph].x;
+    return ks + fl * (P.phase_g[ph].y - ks);
+}
+
 // Density for a particle's volume: summation density for fluids, rho0 for solids
 // and walls.
 fn heat_density(ph: u32, i: u32) -> f32 {
@@ -53,7 +59,7 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (i >= P.counts.x) { return; }
     let ph_i = phase[i];
     if (!conducts(ph_i)) { return; }
-    let k_i = P.phase_c[ph_i].x;
+    let k_i = conductivity(ph_i, heat[i].z);
     let t_i = heat[i].y;
     let eta2 = P.heat.y;
     let pi = pos[i];
@@ -70,8 +76,9 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
                     let ph_j = phase[j];
                     var k_ij = 0.0;
                     if (conducts(ph_j)) {
-                        let k_j = P.phase_c[ph_j].x;
-                        k_ij = c_four() * k_i * k_j / (k_i + k_j);
+                        let k_j = conductivity(ph_j, heat[j].z);
+                        // Ordered operands: both sides of a pair get the same bits.
+                        k_ij = c_four() * min(k_i, k_j) * max(k_i, k_j) / (k_i + k_j);
                     } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
                         k_ij = c_two() * k_i;
                     } else {
@@ -110,7 +117,7 @@ fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
     if (e.x > 0.0) {
         let pv = e.x * pm_exp(-(e.y * (c_one() / t - e.z)));
         let mdot = f.z * pv * sqrt(f.y / t);
-        flux = flux + mdot * (e.w + P.phase_c[ph].y * (t - f.x));
+        flux = flux + mdot * (e.w + P.phase_g[ph].z * (t - f.x));
     }
     if (f.w > 0.0) {
         flux = flux + f.w * (t * t * t * t - P.iface.y);
@@ -129,19 +136,21 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let c = P.phase_c[ph];
     let d = P.phase_d[ph];
     let flags = heat_flags(ph);
+    // Stored enthalpy is relative to h(T_ref) (T_ref = solidus when melting).
     if ((flags & HEAT_MELTS) == 0u) {
-        hv.y = h / c.y;
+        hv.y = c.z + h / c.y;
         hv.z = select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u);
-    } else if (h <= c.z) {
-        hv.y = h / c.y;
+    } else if (h <= 0.0) {
+        hv.y = d.x + h / c.y;
         hv.z = 0.0;
     } else if (h >= c.w) {
-        hv.y = (h - d.z) / c.y;
+        hv.y = d.y + (h - c.w) / P.phase_g[ph].z;
         hv.z = 1.0;
     } else {
-        let f = (h - c.z) / (c.w - c.z);
-        hv.y = d.x + f * (d.y - d.x);
-        hv.z = f;
+        let a = P.phase_g[ph].w;
+        let x = c_two() * h / (d.z + sqrt(d.z * d.z + c_four() * a * h));
+        hv.y = d.x + x;
+        hv.z = x / (d.y - d.x);
     }
     heat[i] = hv;
     // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).

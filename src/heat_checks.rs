@@ -127,7 +127,7 @@ pub fn two_materials(m: &Model, st: &State, interface: f64) -> (String, f64, Vec
 pub fn total_enthalpy(m: &Model, st: &State) -> f64 {
     (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
-        .map(|i| st.mass[i] as f64 * st.heat[i][0] as f64)
+        .map(|i| st.mass[i] as f64 * crate::output::absolute_enthalpy(m, st, i))
         .sum()
 }
 

@@ -31,6 +31,8 @@ pub struct Thermal {
     pub heat_capacity: f64,
     /// (solidus, liquidus, latent heat) when the material melts.
     pub melting: Option<(f64, f64, f64)>,
+    /// Liquid-state (conductivity, heat capacity); equal to the solid's unless given.
+    pub liquid: (f64, f64),
     /// Surface losses (liquid and solid free surfaces).
     pub evaporation: Option<Evaporation>,
     pub emissivity: f64,
@@ -64,13 +66,36 @@ impl Evaporation {
 }
 
 impl Thermal {
-    /// Specific enthalpy h(T) = c_p T + L f_l(T) (J22 (19) with the latent heat
-    /// spread linearly over the melting band).
+    /// The temperature whose enthalpy is stored as zero: the solidus for a melting
+    /// material (so phases that switch into each other share it), else the phase's
+    /// initial temperature. Particles store h − h(T_ref): f32 then resolves the
+    /// enthalpy changes a run makes far more finely than absolute enthalpies near
+    /// c_p T (adiabatic_box with temperature-dependent properties drifted 2.8e-6
+    /// over 10^4 steps with absolute enthalpies).
+    pub fn reference_temperature(&self) -> f64 {
+        self.melting.map_or(self.temperature, |m| m.0)
+    }
+    /// h(T_ref), added back to the stored enthalpy for totals and output.
+    pub fn reference_enthalpy(&self) -> f64 {
+        self.enthalpy(self.reference_temperature())
+    }
+    /// Specific enthalpy h(T) = ∫_0^T c_p dT + L f_l(T) (J22 (19)): c_p is the
+    /// solid's below the solidus, the liquid's above the liquidus and linear in
+    /// between, where the latent heat is spread linearly too.
     pub fn enthalpy(&self, t: f64) -> f64 {
-        let base = self.heat_capacity * t;
-        match self.melting {
-            Some((ts, tl, l)) => base + l * ((t - ts) / (tl - ts)).clamp(0.0, 1.0),
-            None => base,
+        let cs = self.heat_capacity;
+        let Some((ts, tl, l)) = self.melting else {
+            return cs * t;
+        };
+        let cl = self.liquid.1;
+        let dt = tl - ts;
+        if t <= ts {
+            cs * t
+        } else if t < tl {
+            let x = t - ts;
+            cs * t + (cl - cs) * x * x / (2.0 * dt) + l * x / dt
+        } else {
+            cs * tl + (cl - cs) * dt / 2.0 + l + cl * (t - tl)
         }
     }
 }
@@ -597,6 +622,7 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
                 conductivity: 0.0,
                 heat_capacity: 0.0,
                 melting: None,
+                liquid: (0.0, 0.0),
                 evaporation: None,
                 emissivity: 0.0,
                 mushy_damping: 0.0,
@@ -666,11 +692,31 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
             Some(c) => cx.non_negative(&mkey("mushy_damping"), c)?,
             None => 0.0,
         };
+        let liquid = match (mat.liquid_conductivity, mat.liquid_heat_capacity) {
+            (None, None) => (conductivity, heat_capacity),
+            _ if melting.is_none() => {
+                return Err(cx.err(
+                    &mkey("liquid_conductivity"),
+                    "liquid properties need a melting band (solidus, liquidus, latent_heat)",
+                ))
+            }
+            (k, c) => (
+                match k {
+                    Some(k) => cx.positive(&mkey("liquid_conductivity"), k)?,
+                    None => conductivity,
+                },
+                match c {
+                    Some(c) => cx.positive(&mkey("liquid_heat_capacity"), c)?,
+                    None => heat_capacity,
+                },
+            ),
+        };
         ph.thermal = Some(Thermal {
             temperature: t,
             conductivity,
             heat_capacity,
             melting,
+            liquid,
             evaporation,
             emissivity,
             mushy_damping,

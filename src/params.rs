@@ -52,10 +52,11 @@ pub struct Params {
     pub phase_a: [[f32; 4]; MAX_PHASES],
     /// Per phase: wall velocity xyz, slip (0 no-slip, 1 free-slip).
     pub phase_b: [[f32; 4]; MAX_PHASES],
-    /// Per phase (heat): conductivity k, heat capacity c_p, enthalpy at the solidus
-    /// h_s = c_p T_s and at the liquidus h_l = c_p T_l + L.
+    /// Per phase (heat): solid conductivity k_s, solid heat capacity c_s, reference
+    /// temperature T_ref (particles store h − h(T_ref), `Thermal::reference_temperature`),
+    /// band enthalpy h(T_l) − h(T_s) for a melting material.
     pub phase_c: [[f32; 4]; MAX_PHASES],
-    /// Per phase (heat): solidus T_s, liquidus T_l, latent heat L, flags
+    /// Per phase (heat): solidus T_s, liquidus T_l, b = c_s + L/(T_l − T_s), flags
     /// (HEAT_DIRICHLET, HEAT_MELTS, HEAT_LIQUID). A Dirichlet wall keeps its fixed
     /// temperature in the first slot.
     pub phase_d: [[f32; 4]; MAX_PHASES],
@@ -64,7 +65,8 @@ pub struct Params {
     pub phase_e: [[f32; 4]; MAX_PHASES],
     /// Surface losses per phase: T_h0 (K), C_M, 0.82 c_s, ε σ_B (radiation).
     pub phase_f: [[f32; 4]; MAX_PHASES],
-    /// Per phase: mushy-zone sink C (1/s, liquids), unused ×3.
+    /// Per phase: mushy-zone sink C (1/s, liquids), liquid conductivity k_l, liquid
+    /// heat capacity c_l, a = (c_l − c_s)/(2 (T_l − T_s)) (0 without melting).
     pub phase_g: [[f32; 4]; MAX_PHASES],
     /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
     /// (Cleary–Monaghan regularisation), 1 for a heat scene, 1 when the scene
@@ -165,9 +167,17 @@ impl Params {
         let (phase_e, phase_f) = loss_tables(m);
         let mut phase_g = [[0.0f32; 4]; MAX_PHASES];
         for (i, ph) in m.phases.iter().enumerate() {
-            if let Some(t) = ph.thermal.filter(|_| ph.kind == PhaseKind::Liquid) {
+            let Some(t) = ph.thermal else { continue };
+            if ph.kind == PhaseKind::Liquid {
                 phase_g[i][0] = t.mushy_damping as f32;
             }
+            let (kl, cl) = t.liquid;
+            let a = t.melting.map_or(0.0, |(ts, tl, _)| {
+                (cl - t.heat_capacity) / (2.0 * (tl - ts))
+            });
+            phase_g[i][1] = kl as f32;
+            phase_g[i][2] = cl as f32;
+            phase_g[i][3] = a as f32;
         }
         let viscous = if m.limits.viscous.is_finite() {
             m.limits.viscous as f32
@@ -415,13 +425,17 @@ fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
             flags |= (target as u32 + 1) << HEAT_SWITCH_SHIFT;
         }
         let cp = t.heat_capacity;
+        let (band, b) = match t.melting {
+            Some(_) => (t.enthalpy(tl) - t.enthalpy(ts), cp + l / (tl - ts)),
+            None => (0.0, 0.0),
+        };
         c[i] = [
             t.conductivity as f32,
             cp as f32,
-            (cp * ts) as f32,
-            (cp * tl + l) as f32,
+            t.reference_temperature() as f32,
+            band as f32,
         ];
-        d[i] = [ts as f32, tl as f32, l as f32, flags as f32];
+        d[i] = [ts as f32, tl as f32, b as f32, flags as f32];
     }
     (c, d)
 }

@@ -208,6 +208,10 @@ pub struct Material {
     pub solidus: Option<f64>,
     pub liquidus: Option<f64>,
     pub latent_heat: Option<f64>,
+    /// Liquid-state conductivity and heat capacity (default: the solid's); inside
+    /// the melting band both vary linearly with the liquid fraction.
+    pub liquid_conductivity: Option<f64>,
+    pub liquid_heat_capacity: Option<f64>,
     /// Evaporation heat loss F22 (18) with the recoil-pressure law F22 (10), liquid
     /// phases at a free surface.
     pub evaporation: Option<EvaporationDef>,

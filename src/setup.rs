@@ -316,7 +316,7 @@ fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
 fn initial_heat(ph: &crate::model::PhaseInfo) -> [f32; 4] {
     match ph.thermal {
         Some(t) if ph.conducts() => [
-            t.enthalpy(t.temperature) as f32,
+            (t.enthalpy(t.temperature) - t.reference_enthalpy()) as f32,
             t.temperature as f32,
             0.0,
             0.0,

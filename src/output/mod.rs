@@ -77,16 +77,31 @@ pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
         f("id", Values::U32(st.id.clone())),
     ]
     .into_iter()
-    .chain(heat_fields(st))
+    .chain(heat_fields(m, st))
     .collect()
 }
 
+/// Specific enthalpy h(T) of particle i (J/kg): the stored value plus its phase's
+/// reference enthalpy (`Thermal::reference_enthalpy`).
+pub fn absolute_enthalpy(m: &Model, st: &State, i: usize) -> f64 {
+    let reference = m.phases[st.phase[i] as usize]
+        .thermal
+        .filter(|_| m.phases[st.phase[i] as usize].conducts())
+        .map_or(0.0, |t| t.reference_enthalpy());
+    st.heat[i][0] as f64 + reference
+}
+
 /// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).
-fn heat_fields(st: &State) -> Vec<Field> {
+fn heat_fields(m: &Model, st: &State) -> Vec<Field> {
     if st.heat.is_empty() {
         return Vec::new();
     }
     let col = |k: usize| Values::F32(st.heat.iter().map(|h| h[k]).collect());
+    let enthalpy = Values::F32(
+        (0..st.len())
+            .map(|i| absolute_enthalpy(m, st, i) as f32)
+            .collect(),
+    );
     vec![
         Field {
             name: "temperature",
@@ -98,7 +113,7 @@ fn heat_fields(st: &State) -> Vec<Field> {
         },
         Field {
             name: "enthalpy",
-            values: col(0),
+            values: enthalpy,
         },
     ]
 }
@@ -197,9 +212,9 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         if !ph.conducts() {
             continue;
         }
-        let [h, t, fl, _] = st.heat[i];
+        let [_, t, fl, _] = st.heat[i];
         d.max_temperature = d.max_temperature.max(t as f64);
-        d.total_enthalpy += st.mass[i] as f64 * h as f64;
+        d.total_enthalpy += st.mass[i] as f64 * absolute_enthalpy(m, st, i);
         if ph.kind == PhaseKind::Gas {
             continue;
         }

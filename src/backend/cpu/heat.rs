@@ -87,7 +87,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
             if !pr.conducts(ph_i) {
                 return 0.0;
             }
-            let k_i = pr.phase_c[ph_i as usize][0];
+            let k_i = conductivity(pr, ph_i, heat_in[i][2]);
             let t_i = heat_in[i][1];
             let mut sum = 0.0f32;
             for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
@@ -96,8 +96,10 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 }
                 let ph_j = phase[j];
                 let k_ij = if pr.conducts(ph_j) {
-                    let k_j = pr.phase_c[ph_j as usize][0];
-                    4.0 * k_i * k_j / (k_i + k_j)
+                    let k_j = conductivity(pr, ph_j, heat_in[j][2]);
+                    // Ordered operands: i and j compute the same bits, so the
+                    // pair's fluxes cancel exactly in the total enthalpy.
+                    4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
                 } else if pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0 {
                     2.0 * k_i
                 } else {
@@ -140,7 +142,7 @@ pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
     if e[0] > 0.0 {
         let pv = e[0] * pm_exp(-(e[1] * (1.0 / t - e[2])));
         let mdot = f[2] * pv * (f[1] / t).sqrt();
-        flux += mdot * (e[3] + pr.phase_c[phase as usize][1] * (t - f[0]));
+        flux += mdot * (e[3] + pr.phase_g[phase as usize][2] * (t - f[0]));
     }
     if f[3] > 0.0 {
         flux += f[3] * (t * t * t * t - pr.interface[1]);
@@ -148,24 +150,36 @@ pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
     flux * delta / pr.phase_a[phase as usize][0]
 }
 
-/// Temperature and liquid fraction of enthalpy h for a phase.
+/// Temperature and liquid fraction of the stored enthalpy h = h(T) − h(T_ref) for
+/// a phase: the inverse of `Thermal::enthalpy`. T_ref is the solidus for a melting
+/// material: below it T = T_s + h/c_s; in the band h = b x + a x² with
+/// x = T − T_s, solved as x = 2h/(b + √(b² + 4ah)) (exact for a = 0, no
+/// cancellation); above it T = T_l + (h − h_band)/c_l.
 #[inline(always)]
 pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     let c = pr.phase_c[phase as usize];
     let d = pr.phase_d[phase as usize];
+    let g = pr.phase_g[phase as usize];
     let flags = pr.heat_flags(phase);
     if flags & HEAT_MELTS == 0 {
         let fl = if flags & HEAT_LIQUID != 0 { 1.0 } else { 0.0 };
-        return (h / c[1], fl);
+        return (c[2] + h / c[1], fl);
     }
-    if h <= c[2] {
-        (h / c[1], 0.0)
+    if h <= 0.0 {
+        (d[0] + h / c[1], 0.0)
     } else if h >= c[3] {
-        ((h - d[2]) / c[1], 1.0)
+        (d[1] + (h - c[3]) / g[2], 1.0)
     } else {
-        let f = (h - c[2]) / (c[3] - c[2]);
-        (d[0] + f * (d[1] - d[0]), f)
+        let x = 2.0 * h / (d[2] + (d[2] * d[2] + 4.0 * g[3] * h).sqrt());
+        (d[0] + x, x / (d[1] - d[0]))
     }
+}
+
+/// Conductivity at liquid fraction f_l: solid's plus f_l times the liquid's excess.
+#[inline(always)]
+pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
+    let ks = pr.phase_c[phase as usize][0];
+    ks + fl * (pr.phase_g[phase as usize][1] - ks)
 }
 
 /// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a
@@ -207,4 +221,31 @@ pub fn temperature(pr: &Params, st: &mut State) {
                 *ab = [0.0; 4];
             }
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::params::Params;
+
+    /// T(h(T)) = T across the melting band for a material whose liquid heat
+    /// capacity differs from the solid's (adiabatic_box: c_s 1000, c_l 1200, band
+    /// 340–360 K, L = 5e4 J/kg), and f_l is linear in T in the band.
+    #[test]
+    fn temperature_inverts_enthalpy_across_the_band() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/adiabatic_box.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        let pr = Params::new(&l.model, l.state.len() as u32);
+        let hot = l.model.phase_index("hot").unwrap();
+        let th = l.model.phases[hot].thermal.unwrap();
+        for t in [300.0, 339.0, 341.0, 350.0, 355.5, 359.9, 361.0, 450.0] {
+            let h = (th.enthalpy(t) - th.reference_enthalpy()) as f32;
+            let (tt, fl) = super::temperature_of(&pr, hot as u32, h);
+            assert!((tt as f64 - t).abs() < 1e-4, "T({t}) -> {tt}");
+            let expect = ((t - 340.0) / 20.0).clamp(0.0, 1.0);
+            assert!((fl as f64 - expect).abs() < 1e-4, "f_l({t}) = {fl}");
+        }
+    }
 }

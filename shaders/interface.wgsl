@@ -16,7 +16,7 @@ fn volume(j: u32) -> f32 {
 fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     let n = P.counts.x;
-    if (i >= n) { return; }
+    if (i >= n || P.iface.z != 0.0) { return; }
     var g = 0.0;
     if (condensed(phase[i])) {
         let pi = pos[i];
@@ -39,11 +39,65 @@ fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     surface[n + i] = vec4<f32>(g, 0.0, 0.0, 0.0);
 }
 
+fn vol_density(j: u32) -> f32 {
+    let ph = phase[j];
+    if (is_wall(ph)) {
+        return P.phase_a[ph].x;
+    }
+    return rho[j];
+}
+
+// F22 (19)-(20): condensed-gas interface, for scenes with gas particles.
+fn gas_interface(i: u32) {
+    let ph = phase[i];
+    if (!conducts(ph)) {
+        surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        return;
+    }
+    let side = condensed(ph);
+    let rho_i = vol_density(i);
+    let v_i = mass[i] / rho_i;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var g = vec3<f32>(0.0, 0.0, 0.0);
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                for (var j = rg.x; j < rg.y; j++) {
+                    let d = min_image(pi, pos[j]);
+                    let r2 = len2(d);
+                    if (r2 >= P.kern.w || r2 <= 0.0 || condensed(phase[j]) == side) { continue; }
+                    let rho_j = vol_density(j);
+                    let v_j = mass[j] / rho_j;
+                    let r = sqrt(r2);
+                    let f = (v_i * v_i + v_j * v_j) * (rho_i / (rho_i + rho_j)) * kernel_dw(r) / r;
+                    g.x = g.x + f * d.x;
+                    g.y = g.y + f * d.y;
+                    g.z = g.z + f * d.z;
+                }
+            }
+        }
+    }
+    g = vec3<f32>(g.x / v_i, g.y / v_i, g.z / v_i);
+    let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    if (delta > c_tenth() * P.kern.y) {
+        surface[i] = vec4<f32>(g.x / delta, g.y / delta, g.z / delta, delta * P.iface.x);
+    } else {
+        surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+}
+
 @compute @workgroup_size(64)
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     let n = P.counts.x;
     if (i >= n) { return; }
+    if (P.iface.z != 0.0) {
+        gas_interface(i);
+        return;
+    }
     let ph = phase[i];
     if (!condensed(ph) || !conducts(ph)) {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);

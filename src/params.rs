@@ -76,8 +76,9 @@ pub struct Params {
     /// (0 none, LASER_BEER_LAMBERT, LASER_SURFACE).
     pub laser: [f32; 4],
     /// Interface pass: 1/κ, the normalisation of the surface delta (κ = Σ δ V per
-    /// unit area across a planar lattice surface, `surface_delta_integral`);
-    /// T_ambient⁴ for radiation; unused; unused.
+    /// unit area across a planar lattice surface, `surface_delta_integral` or
+    /// `gas_delta_integral`); T_ambient⁴ for radiation; 1 in F22 gas mode (the
+    /// scene has gas particles); unused.
     pub interface: [f32; 4],
     /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
     /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
@@ -230,7 +231,18 @@ impl Params {
             ..laser_block(m)
         };
         if m.needs_interface() {
-            p.interface[0] = (1.0 / surface_delta_integral(&p, m.dx)) as f32;
+            let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);
+            let condensed = m.phases.iter().find(|ph| {
+                matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid) && ph.conducts()
+            });
+            let kappa = match (gas, condensed) {
+                (Some(g), Some(c)) => {
+                    p.interface[2] = 1.0;
+                    gas_delta_integral(&p, m.dx, c.rho0, g.rho0)
+                }
+                _ => surface_delta_integral(&p, m.dx),
+            };
+            p.interface[0] = (1.0 / kappa) as f32;
             p.interface[1] = m.ambient_temperature.powi(4) as f32;
         }
         p
@@ -303,6 +315,52 @@ pub fn surface_delta_integral(p: &Params, dx: f64) -> f64 {
                 })
                 .sum();
             // Layers below the normal threshold get no normal and absorb nothing.
+            if g.abs() > 0.1 * p.kernel[1] as f64 {
+                g.abs() * dx
+            } else {
+                0.0
+            }
+        })
+        .sum()
+}
+
+/// κ_F22: the condensed side's ∫δ dn for the F22 (19) colour gradient across a
+/// planar lattice interface between condensed material (density ρ_c, below) and
+/// gas (ρ_g, above). The density weight ρ_i/(ρ_i + ρ_j) gives the condensed side
+/// nearly all of the jump (F22 Remark 3) when ρ_c ≫ ρ_g.
+pub fn gas_delta_integral(p: &Params, dx: f64, rho_c: f64, rho_g: f64) -> f64 {
+    let dim = p.counts[2] as i64;
+    let support = (p.kernel[3] as f64).sqrt();
+    let reach = (support / dx).ceil() as i64 + 1;
+    let vol_c = dx.powi(dim as i32);
+    // Every lattice site holds volume Δx^d whatever its phase (m = ρ0 Δx^d).
+    let vol_g = vol_c;
+    let weight = rho_c / (rho_c + rho_g);
+    (0..2 * reach)
+        .map(|k| {
+            // Condensed particle at depth (k + ½)Δx; gas sites at heights (kg + ½)Δx.
+            let mut g = 0.0;
+            for kg in 0..reach {
+                let dz = (k + kg + 1) as f64 * dx; // vertical distance (condensed below)
+                for a in -reach..=reach {
+                    for b in -reach..=reach {
+                        if dim == 2 && b != 0 {
+                            continue;
+                        }
+                        let r2 = (a * a + b * b) as f64 * dx * dx + dz * dz;
+                        if r2 >= support * support {
+                            continue;
+                        }
+                        let r = r2.sqrt();
+                        let f = (vol_c * vol_c + vol_g * vol_g)
+                            * weight
+                            * crate::kernel::dw(p, r as f32) as f64
+                            / r;
+                        g += f * -dz;
+                    }
+                }
+            }
+            let g = g / vol_c;
             if g.abs() > 0.1 * p.kernel[1] as f64 {
                 g.abs() * dx
             } else {

@@ -96,6 +96,8 @@ fn heat_passes_200_steps() {
         &["laser.model=\"gaussian_surface\""],
         200,
     );
+    // F22 (19)-(20) interface between the plate and gas particles.
+    assert_bit_identical("laser_plate_under_gas_2d", &[], 200);
     // Radiation through the free surface of a hot plate.
     assert_bit_identical(
         "laser_flat_plate",

@@ -224,3 +224,10 @@ fn rosenthal_scan_line_within_5_percent() {
     let (v, pass) = check_value("rosenthal_2d", &[]);
     assert!(pass && v <= 0.05, "{v}");
 }
+
+/// The surface flux through the condensed–gas interface of F22 (19)–(20).
+#[test]
+fn laser_through_the_gas_interface_within_1_percent() {
+    let (v, pass) = check_value("laser_plate_under_gas_2d", &[]);
+    assert!(pass && v <= 0.01, "{v}");
+}

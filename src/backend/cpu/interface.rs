@@ -9,6 +9,14 @@
 //!   surface fluxes must not reach them),
 //! κ the planar-lattice normalisation (params::surface_delta_integral),
 //! over condensed neighbours j, V = m/ρ0. Stored for liquid and solid particles.
+//!
+//! With gas particles in the scene the interface is the condensed–gas one of
+//! F22 (19)–(20) instead, for every conducting particle i over neighbours j of the
+//! other class (condensed: liquid, solid, wall; or gas):
+//!   ∇c_i = (1/V_i) Σ_j (V_i² + V_j²) ρ_i/(ρ_i + ρ_j) ∂W/∂r e_ij,
+//!   δ_i = |∇c_i|/κ_F22,  n_i = ∇c_i/|∇c_i| (outward with respect to i's phase),
+//! V = m/ρ (summation density for fluids, ρ0 for solids and walls), κ_F22 the
+//! same planar-lattice normalisation of the condensed side's δ.
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
@@ -22,6 +30,9 @@ pub fn condensed(pr: &Params, phase: u32) -> bool {
 }
 
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
+    if pr.interface[2] != 0.0 {
+        return gas_interface(pr, st, grid);
+    }
     let n = st.len();
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let vol = |j: usize| mass[j] / pr.phase_a[phase[j] as usize][0];
@@ -71,4 +82,60 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     for (s, g) in st.surface[n..].iter_mut().zip(gamma) {
         *s = [g, 0.0, 0.0, 0.0];
     }
+}
+
+/// Density of a particle for volumes: summation density for fluids, ρ0 otherwise.
+#[inline(always)]
+fn density(pr: &Params, st: &State, j: usize) -> f32 {
+    let ph = st.phase[j];
+    if pr.is_wall(ph) {
+        pr.phase_a[ph as usize][0]
+    } else {
+        st.rho[j]
+    }
+}
+
+/// F22 (19)–(20) between condensed particles and gas particles.
+fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
+    let n = st.len();
+    let inv_h = pr.kernel[1];
+    let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
+    let s: &State = st;
+    let normals: Vec<[f32; 4]> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if !pr.conducts(phase[i]) {
+                return [0.0; 4];
+            }
+            let side = condensed(pr, phase[i]);
+            let rho_i = density(pr, s, i);
+            let v_i = mass[i] / rho_i;
+            let mut g = [0.0f32; 3];
+            for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
+                if r2 <= 0.0 || condensed(pr, phase[j]) == side {
+                    return;
+                }
+                let rho_j = density(pr, s, j);
+                let v_j = mass[j] / rho_j;
+                let r = r2.sqrt();
+                let f = (v_i * v_i + v_j * v_j) * (rho_i / (rho_i + rho_j)) * kernel::dw(pr, r) / r;
+                for a in 0..3 {
+                    g[a] += f * d[a];
+                }
+            });
+            let g = [g[0] / v_i, g[1] / v_i, g[2] / v_i];
+            let delta = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            if delta > 0.1 * inv_h {
+                [
+                    g[0] / delta,
+                    g[1] / delta,
+                    g[2] / delta,
+                    delta * pr.interface[0],
+                ]
+            } else {
+                [0.0; 4]
+            }
+        })
+        .collect();
+    st.surface[..n].copy_from_slice(&normals);
 }

@@ -42,6 +42,7 @@ struct Sim {
 }
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
+const FLAG_VISCOUS_HEATING: u32 = 16u;
 const KIND_WALL: f32 = 2.0;
 const KIND_SOLID: f32 = 3.0;
 const HEAT_DIRICHLET: u32 = 1u;

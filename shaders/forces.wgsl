@@ -21,6 +21,8 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let zr = z_range();
     var f = vec3<f32>(0.0);
     var fb = vec3<f32>(0.0);
+    var heating = 0.0;
+    let viscous_heating = (P.grid.w & FLAG_VISCOUS_HEATING) != 0u;
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
@@ -61,12 +63,31 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                             f[a] = f[a] + vv * (fp * d[a] + fv * u);
                             fb[a] = fb[a] + vv * (fbg * d[a]);
                         }
+                        if (viscous_heating) {
+                            // Power the pair's viscous force dissipates: fluid pairs
+                            // share F.(u_i - u_j); against a wall it is F.(u_i - U_wall)
+                            // with the wall's real velocity (the mirrored one is a ghost).
+                            var w = v_j.xyz;
+                            var share = c_half();
+                            if (wall) {
+                                w = P.phase_b[ph_j].xyz;
+                                share = c_one();
+                            }
+                            let ux = v_i.x - v_j.x;
+                            let uy = v_i.y - v_j.y;
+                            let uz = v_i.z - v_j.z;
+                            let wx = v_i.x - w.x;
+                            let wy = v_i.y - w.y;
+                            let wz = v_i.z - w.z;
+                            let uw = ux * wx + uy * wy + uz * wz;
+                            heating = heating - share * vv * fv * uw;
+                        }
                     }
                 }
             }
         }
     }
     let g = P.gravity;
-    acc[i] = vec4<f32>(f.x / m_i + g.x, f.y / m_i + g.y, f.z / m_i + g.z, 0.0);
+    acc[i] = vec4<f32>(f.x / m_i + g.x, f.y / m_i + g.y, f.z / m_i + g.z, heating / m_i);
     acc_b[i] = vec4<f32>(fb.x / m_i, fb.y / m_i, fb.z / m_i, 0.0);
 }

@@ -97,6 +97,9 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (P.laser.w != 0.0) {
         source = heat[i].w;
     }
+    if ((P.grid.w & FLAG_VISCOUS_HEATING) != 0u) {
+        source = source + acc[i].w;
+    }
     var loss = 0.0;
     if (P.heat.w != 0.0) {
         loss = surface_loss(ph_i, t_i, surface[i].w);

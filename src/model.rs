@@ -167,6 +167,7 @@ pub struct Model {
     pub gravity: [f64; 3],
     pub background_pressure: f64,
     pub pressure_floor: bool,
+    pub viscous_heating: bool,
     pub ambient_temperature: f64,
     pub jitter: f64,
     pub seed: u64,
@@ -438,6 +439,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         wall_layers,
         gravity,
         background_pressure: sim.background_pressure,
+        viscous_heating: sim.viscous_heating,
         ambient_temperature: cx
             .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
         pressure_floor: sim.pressure_floor,

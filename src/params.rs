@@ -10,6 +10,8 @@ pub const FLAG_PERIODIC_X: u32 = 1;
 pub const FLAG_PERIODIC_Y: u32 = 2;
 pub const FLAG_PERIODIC_Z: u32 = 4;
 pub const FLAG_PRESSURE_FLOOR: u32 = 8;
+/// Forces pass writes the viscous dissipation (W/kg) into acc.w; heat adds it.
+pub const FLAG_VISCOUS_HEATING: u32 = 16;
 
 pub const KIND_LIQUID: f32 = 0.0;
 pub const KIND_GAS: f32 = 1.0;
@@ -144,6 +146,9 @@ impl Params {
         }
         if m.pressure_floor {
             flags |= FLAG_PRESSURE_FLOOR;
+        }
+        if m.viscous_heating && m.is_thermal() {
+            flags |= FLAG_VISCOUS_HEATING;
         }
         let mut phase_a = [[0.0f32; 4]; MAX_PHASES];
         let mut phase_b = [[0.0f32; 4]; MAX_PHASES];

@@ -143,6 +143,10 @@ pub struct Simulation {
     pub jitter: f64,
     #[serde(default = "default_seed")]
     pub seed: u64,
+    /// Viscous heating: the kinetic energy the viscous forces F22 (23) remove turns
+    /// into enthalpy (heat scenes).
+    #[serde(default)]
+    pub viscous_heating: bool,
     /// Temperature of the surroundings for radiation loss (K).
     #[serde(default = "default_ambient")]
     pub ambient_temperature: f64,

@@ -119,6 +119,21 @@ fn heat_passes_200_steps() {
     );
 }
 
+/// Viscous heating in sheared flow (forces pass writes it, heat pass adds it).
+#[test]
+fn viscous_heating_couette_200_steps() {
+    assert_bit_identical(
+        "couette_2d",
+        &[
+            "materials.fluid.conductivity=0.6",
+            "materials.fluid.heat_capacity=4186.0",
+            "phases.liquid.temperature=300.0",
+            "simulation.viscous_heating=true",
+        ],
+        200,
+    );
+}
+
 const HOT_WATER: [&str; 4] = [
     "materials.water.conductivity=0.6",
     "materials.water.heat_capacity=4186.0",

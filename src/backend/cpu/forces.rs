@@ -6,10 +6,14 @@
 //! and gravity. A wall neighbour enters with the pressure the wall pass extrapolated,
 //! the density the fluid's own EOS gives at that pressure, the fluid's mass and
 //! viscosity, and the no-slip velocity (no viscous term for free-slip walls).
+//! With viscous heating on, acc.w carries the power the viscous terms dissipate,
+//! −Σ_j s_ij (V_i² + V_j²) η̃_ij (∂W/∂r / r_ij) u_ij·w_ij per unit mass: a fluid
+//! pair has w = u_ij and s = ½ (both sides count it); a wall pair w = u_i − U_wall
+//! and s = 1, so that heat = wall work − kinetic-energy change exactly.
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::Params;
+use crate::params::{Params, FLAG_VISCOUS_HEATING};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -31,6 +35,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             let pb = pr.gravity[3];
             let mut f = [0.0f32; 3];
             let mut fb = [0.0f32; 3];
+            let mut heating = 0.0f32;
+            let viscous_heating = pr.grid[3] & FLAG_VISCOUS_HEATING != 0;
             for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
                 if r2 <= 0.0 {
                     return;
@@ -65,9 +71,28 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                     f[a] += vv * (fp * d[a] + fv * u);
                     fb[a] += vv * (fbg * d[a]);
                 }
+                if viscous_heating {
+                    // Power the pair's viscous force dissipates: fluid pairs share
+                    // F·(u_i − u_j); against a wall it is F·(u_i − U_wall) with the
+                    // wall's real velocity (the mirrored one is a ghost).
+                    let (w, share) = if wall {
+                        (pr.phase_b[ph_j as usize], 1.0)
+                    } else {
+                        (v_j, 0.5)
+                    };
+                    let (ux, uy, uz) = (v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]);
+                    let (wx, wy, wz) = (v_i[0] - w[0], v_i[1] - w[1], v_i[2] - w[2]);
+                    let uw = ux * wx + uy * wy + uz * wz;
+                    heating -= share * vv * fv * uw;
+                }
             });
             let g = pr.gravity;
-            *acc = [f[0] / m_i + g[0], f[1] / m_i + g[1], f[2] / m_i + g[2], 0.0];
+            *acc = [
+                f[0] / m_i + g[0],
+                f[1] / m_i + g[1],
+                f[2] / m_i + g[2],
+                heating / m_i,
+            ];
             *acc_b = [fb[0] / m_i, fb[1] / m_i, fb[2] / m_i, 0.0];
         });
 }

@@ -78,6 +78,8 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     // The laser pass left its source (W/kg) in heat.w.
     let laser_on = pr.laser[3] != 0.0;
     let surface_on = pr.heat[3] != 0.0;
+    let viscous_heating = pr.grid[3] & crate::params::FLAG_VISCOUS_HEATING != 0;
+    let acc = &st.acc;
     let surf = &st.surface;
     let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let rates: Vec<f32> = (0..st.len())
@@ -110,7 +112,10 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
                 sum += v_j * k_ij * (t_i - heat_in[j][1]) * f;
             });
-            let source = if laser_on { heat_in[i][3] } else { 0.0 };
+            let mut source = if laser_on { heat_in[i][3] } else { 0.0 };
+            if viscous_heating {
+                source += acc[i][3];
+            }
             let loss = if surface_on {
                 surface_loss(pr, ph_i, t_i, surf[i][3])
             } else {

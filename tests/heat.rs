@@ -239,7 +239,6 @@ fn laser_through_the_gas_interface_within_1_percent() {
 /// 3% leaves room for the kernel-discretised shear near the walls at other settings.
 #[test]
 fn viscous_heating_matches_couette_dissipation() {
-    use spatter::backend::Backend;
     let sets: Vec<String> = [
         "materials.fluid.conductivity=0.6",
         "materials.fluid.heat_capacity=4186.0",

@@ -194,6 +194,19 @@ fn sigint_half_way_leaves_a_finished_mcap() {
 }
 
 #[test]
+fn sigterm_finishes_the_mcap_too() {
+    let dir = scratch("outputs_sigterm");
+    let child = start_long_run(&dir);
+    signal(&child, "-TERM");
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(130), "{stdout}{stderr}");
+    let sum = summary(&dir.join("run.mcap"));
+    assert_eq!(sum["complete"], true, "{sum}");
+    assert!(sum["frames"].as_u64().unwrap() >= 4, "{sum}");
+}
+
+#[test]
 fn hard_kill_leaves_mcap_readable_to_its_last_chunk() {
     let dir = scratch("outputs_sigkill");
     let mut child = start_long_run(&dir);

@@ -81,6 +81,9 @@ const WG: u32 = 64u;
 // Interface scenes: (normal, delta) per particle, then the Shepard sums; a
 // placeholder otherwise.
 @group(0) @binding(25) var<storage, read_write> surface: array<vec4<f32>>;
+// 1 where a cell holds a fluid particle (set in cell_bounds; the wall pass skips
+// wall particles with no such cell around them). Order-free integer atomics.
+@group(0) @binding(26) var<storage, read_write> cell_fluid: array<atomic<u32>>;
 
 // Linear thread index for 1D work split over a 2D dispatch grid (65535-group limit).
 fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
@@ -197,6 +200,15 @@ fn wrap_cell(c: i32, a: u32) -> i32 {
     if (c >= 0 && c < n) { return c; }
     if ((P.grid.w & (1u << a)) != 0u) { return (c + n) % n; }
     return -1;
+}
+
+// Index of neighbour cell ci + off (wrapped on periodic axes), -1 outside the grid.
+fn neighbor_cell_index(ci: vec3<i32>, off: vec3<i32>) -> i32 {
+    let cx = wrap_cell(ci.x + off.x, 0u);
+    let cy = wrap_cell(ci.y + off.y, 1u);
+    let cz = wrap_cell(ci.z + off.z, 2u);
+    if (cx < 0 || cy < 0 || cz < 0) { return -1; }
+    return cx + i32(P.grid.x) * (cy + i32(P.grid.y) * cz);
 }
 
 // Start and end of the sorted particles in neighbour cell ci + off (empty if outside).

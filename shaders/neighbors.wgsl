@@ -70,4 +70,7 @@ fn cell_bounds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (k == n - 1u || keys[k + 1u].x != c) {
         cell_end[c] = k + 1u;
     }
+    if (!is_wall(phase[k])) {
+        atomicOr(&cell_fluid[c], 1u);
+    }
 }

@@ -14,22 +14,36 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var sp = 0.0;
     var sr = vec3<f32>(0.0);
     var sv = vec3<f32>(0.0);
+    // Without fluid in the cells around, the sums stay zero: skip the loop.
+    var gather = false;
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
-                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
-                for (var j = rg.x; j < rg.y; j++) {
-                    let d = min_image(pi, pos[j]);
-                    let r2 = len2(d);
-                    if (r2 < P.kern.w && !is_wall(phase[j])) {
-                        let wk = kernel_w(sqrt(r2));
-                        sw = sw + wk;
-                        sp = sp + press[j] * wk;
-                        let rw = rho[j] * wk;
-                        let v = vel[j];
-                        for (var a = 0u; a < 3u; a++) {
-                            sr[a] = sr[a] + rw * d[a];
-                            sv[a] = sv[a] + v[a] * wk;
+                let c = neighbor_cell_index(ci, vec3<i32>(dx, dy, dz));
+                if (c >= 0 && atomicLoad(&cell_fluid[u32(c)]) != 0u) {
+                    gather = true;
+                }
+            }
+        }
+    }
+    if (gather) {
+        for (var dz = -zr; dz <= zr; dz++) {
+            for (var dy = -1; dy <= 1; dy++) {
+                for (var dx = -1; dx <= 1; dx++) {
+                    let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+                    for (var j = rg.x; j < rg.y; j++) {
+                        let d = min_image(pi, pos[j]);
+                        let r2 = len2(d);
+                        if (r2 < P.kern.w && !is_wall(phase[j])) {
+                            let wk = kernel_w(sqrt(r2));
+                            sw = sw + wk;
+                            sp = sp + press[j] * wk;
+                            let rw = rho[j] * wk;
+                            let v = vel[j];
+                            for (var a = 0u; a < 3u; a++) {
+                                sr[a] = sr[a] + rw * d[a];
+                                sv[a] = sv[a] + v[a] * wk;
+                            }
                         }
                     }
                 }

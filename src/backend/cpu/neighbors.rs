@@ -10,6 +10,36 @@ use rayon::prelude::*;
 pub struct CellTable {
     pub start: Vec<u32>,
     pub end: Vec<u32>,
+    /// The cell holds at least one fluid particle (the wall pass skips wall
+    /// particles with no such cell around them).
+    pub fluid: Vec<bool>,
+}
+
+/// True if any cell the neighbour loop of point `pi` visits holds fluid.
+#[inline(always)]
+pub fn fluid_nearby(pr: &Params, grid: &CellTable, pi: &[f32; 4]) -> bool {
+    let ci = cell_coord(pr, pi);
+    let zr = if pr.counts[2] == 3 { 1 } else { 0 };
+    let flags = pr.grid[3];
+    for dz in -zr..=zr {
+        let Some(cz) = wrap(ci[2] + dz, pr.grid[2], flags & 4 != 0) else {
+            continue;
+        };
+        for dy in -1..=1 {
+            let Some(cy) = wrap(ci[1] + dy, pr.grid[1], flags & 2 != 0) else {
+                continue;
+            };
+            for dx in -1..=1 {
+                let Some(cx) = wrap(ci[0] + dx, pr.grid[0], flags & 1 != 0) else {
+                    continue;
+                };
+                if grid.fluid[(cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize] {
+                    return true;
+                }
+            }
+        }
+    }
+    false
 }
 
 /// Integer cell coordinates of a position, clamped into the grid.
@@ -133,6 +163,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     grid.start.resize(n_cells, 0);
     grid.end.clear();
     grid.end.resize(n_cells, 0);
+    grid.fluid.clear();
+    grid.fluid.resize(n_cells, false);
     for k in 0..n {
         let c = keys[k].0;
         if k == 0 || keys[k - 1].0 != c {
@@ -140,6 +172,9 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
         }
         if k == n - 1 || keys[k + 1].0 != c {
             grid.end[c as usize] = k as u32 + 1;
+        }
+        if !pr.is_wall(st.phase[k]) {
+            grid.fluid[c as usize] = true;
         }
     }
 }

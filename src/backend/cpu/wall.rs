@@ -4,7 +4,21 @@
 //!   ũ_w = Σ u_f W_wf / Σ W_wf,  u_w = 2 u_wall − ũ_w        (no-slip velocity)
 //! The wall's displayed density is its material's EOS inverted at p_w.
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::neighbors::{fluid_nearby, for_each_neighbor, CellTable};
+
+#[inline(always)]
+fn for_each_neighbor_if(
+    gather: bool,
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    i: usize,
+    f: impl FnMut(usize, [f32; 3], f32),
+) {
+    if gather {
+        for_each_neighbor(pr, pos, grid, i, f);
+    }
+}
 use crate::kernel;
 use crate::params::{Params, FLAG_PRESSURE_FLOOR};
 use crate::state::State;
@@ -25,7 +39,10 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             let mut sp = 0.0f32;
             let mut sr = [0.0f32; 3];
             let mut sv = [0.0f32; 3];
-            for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
+            // Without fluid in the cells around, the sums stay zero: skip the loop
+            // (most of a substrate in a heat scene).
+            let gather = fluid_nearby(pr, grid, &pos[i]);
+            for_each_neighbor_if(gather, pr, pos, grid, i, |j, d, r2| {
                 if pr.is_wall(phase[j]) {
                     return;
                 }

@@ -71,6 +71,7 @@ struct Buffers {
     keys: wgpu::Buffer,
     cell_start: wgpu::Buffer,
     cell_end: wgpu::Buffer,
+    cell_fluid: wgpu::Buffer,
     scratch: [wgpu::Buffer; 7],
     sim: wgpu::Buffer,
     partials: wgpu::Buffer,
@@ -159,6 +160,7 @@ impl GpuBackend {
             keys: storage(device, "keys", n_pad as u64 * 8),
             cell_start: storage(device, "cell_start", n_cells * 4),
             cell_end: storage(device, "cell_end", n_cells * 4),
+            cell_fluid: storage(device, "cell_fluid", n_cells * 4),
             scratch: [
                 storage(device, "s_pos", v4),
                 storage(device, "s_vel", v4),
@@ -378,6 +380,7 @@ impl GpuBackend {
         }
         enc.clear_buffer(&b.cell_start, 0, None);
         enc.clear_buffer(&b.cell_end, 0, None);
+        enc.clear_buffer(&b.cell_fluid, 0, None);
         let mut pass = self.begin_pass_marked(enc, "neighbors.cell_bounds", idx, false, true);
         self.dispatch(&mut pass, "cell_bounds", self.n);
     }
@@ -495,7 +498,7 @@ fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayo
         },
         count: None,
     }];
-    for b in 1..=25 {
+    for b in 1..=26 {
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: b,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -532,7 +535,7 @@ fn main_bind_group(
     layout: &wgpu::BindGroupLayout,
     b: &Buffers,
 ) -> wgpu::BindGroup {
-    let list: [&wgpu::Buffer; 26] = [
+    let list: [&wgpu::Buffer; 27] = [
         &b.params,
         &b.pos,
         &b.vel,
@@ -559,6 +562,7 @@ fn main_bind_group(
         &b.s_heat,
         &b.bins,
         &b.surface,
+        &b.cell_fluid,
     ];
     let entries: Vec<wgpu::BindGroupEntry> = list
         .iter()

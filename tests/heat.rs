@@ -288,11 +288,31 @@ fn viscous_heating_matches_couette_dissipation() {
 /// quick-look setting its header names runs and melts a track.
 #[test]
 fn line_melt_example_runs_at_its_quick_look_resolution() {
-    let path = format!("{}/scenarios/pbf/line_melt_bare_plate.toml", env!("CARGO_MANIFEST_DIR"));
-    let out = spatter(&["run", "--backend", "cpu", &path, "--set", "dx=2e-5", "--until", "1.2e-4"]);
+    let path = format!(
+        "{}/scenarios/pbf/line_melt_bare_plate.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = spatter(&[
+        "run",
+        "--backend",
+        "cpu",
+        &path,
+        "--set",
+        "dx=2e-5",
+        "--until",
+        "1.2e-4",
+    ]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
     let line = stdout.lines().find(|l| l.starts_with("heat: ")).unwrap();
-    let melted: f64 = line.split("melted volume ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
+    let melted: f64 = line
+        .split("melted volume ")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(melted > 0.0, "{line}");
 }

@@ -56,6 +56,19 @@ fn laser_bins(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     bins[b] = vec2<f32>(sum, 0.0);
 }
 
+// zeta s_l at point p: zeta P s0 exp(-2 d^2/r_w^2), d the lateral distance from the
+// beam centre; both laser models share it.
+fn irradiance(p: vec4<f32>, centre: vec2<f32>, power: f32) -> f32 {
+    let d0 = p.x - centre.x;
+    var d1 = 0.0;
+    if (P.counts.z == 3u) {
+        d1 = p.y - centre.y;
+    }
+    let r2 = d0 * d0 + d1 * d1;
+    let rw = P.laser.y;
+    return P.laser.x * power * P.laser_grid.y * pm_exp(-(c_two() * r2 / (rw * rw)));
+}
+
 fn beam_centre(t: f32) -> vec2<f32> {
     let n = P.laser_bins.w % 256u;
     if (t <= P.laser_path[0].x) {
@@ -95,18 +108,10 @@ fn laser_columns(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let t = sim.time;
     let centre = beam_centre(t);
     let power = beam_power(t);
-    let zeta = P.laser.x;
-    let rw = P.laser.y;
     let a = P.laser.z;
     let dx = P.laser_grid.x;
     let top = bin_centre(vec3<u32>(c % nb.x, select(0u, c / nb.x, three), 0u));
-    let d0 = top.x - centre.x;
-    var d1 = 0.0;
-    if (three) {
-        d1 = top.y - centre.y;
-    }
-    let r2 = d0 * d0 + d1 * d1;
-    var i = zeta * power * P.laser_grid.y * pm_exp(-(c_two() * r2 / (rw * rw))) * P.laser_grid.w;
+    var i = irradiance(top, centre, power) * P.laser_grid.w;
     for (var k = i32(depth) - 1; k >= 0; k--) {
         let b = c + u32(k) * stride;
         let vf = bins[b].x / P.laser_grid.z;
@@ -130,12 +135,15 @@ fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     if (i >= P.counts.x) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
-    var hv = heat[i];
-    if (!absorbs(ph)) {
-        hv.w = 0.0;
-        heat[i] = hv;
-        return;
+    if (absorbs(ph)) {
+        heat[i].w = binned_source(i, ph);
+    } else {
+        heat[i].w = 0.0;
     }
+}
+
+// Share of the neighbouring bins' power particle i takes, per unit mass.
+fn binned_source(i: u32, ph: u32) -> f32 {
     let p = pos[i];
     let v = mass[i] / P.phase_a[ph].x;
     let dx = P.laser_grid.x;
@@ -164,8 +172,7 @@ fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             }
         }
     }
-    hv.w = sum / mass[i];
-    heat[i] = hv;
+    return sum / mass[i];
 }
 
 // Gaussian surface flux F22 (17): q = zeta <-n.e_l> s_l(x) delta / rho0, e_l = -e_up.
@@ -175,27 +182,13 @@ fn laser_surface(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     if (i >= P.counts.x) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
-    var hv = heat[i];
     if (!absorbs(ph)) {
-        hv.w = 0.0;
-        heat[i] = hv;
+        heat[i].w = 0.0;
         return;
     }
     let up = P.counts.z - 1u;
-    let t = sim.time;
-    let centre = beam_centre(t);
-    let power = beam_power(t);
-    let p = pos[i];
-    let d0 = p.x - centre.x;
-    var d1 = 0.0;
-    if (up == 2u) {
-        d1 = p.y - centre.y;
-    }
-    let r2 = d0 * d0 + d1 * d1;
-    let rw = P.laser.y;
-    let irradiance = P.laser.x * power * P.laser_grid.y * pm_exp(-(c_two() * r2 / (rw * rw)));
     let s = surface[i];
     let cosine = max(s[up], 0.0);
-    hv.w = irradiance * cosine * s.w / P.phase_a[ph].x;
-    heat[i] = hv;
+    let q = irradiance(pos[i], beam_centre(sim.time), beam_power(sim.time));
+    heat[i].w = q * cosine * s.w / P.phase_a[ph].x;
 }

@@ -113,6 +113,31 @@ pub fn beam_power(pr: &Params, t: f32) -> f32 {
     p
 }
 
+/// ζ s_l at point p: ζ P s0 exp(−2 d²/r_w²), d the lateral distance from the beam
+/// centre (F22 (17), R18 (3.42)); both laser models share it.
+#[inline(always)]
+fn irradiance(pr: &Params, p: &[f32; 4], centre: [f32; 2], power: f32) -> f32 {
+    let d0 = p[0] - centre[0];
+    let d1 = if pr.counts[2] == 3 {
+        p[1] - centre[1]
+    } else {
+        0.0
+    };
+    let r2 = d0 * d0 + d1 * d1;
+    let [zeta, rw, _, _] = pr.laser;
+    zeta * power * pr.laser_grid[1] * pm_exp(-(2.0 * r2 / (rw * rw)))
+}
+
+/// Store each conducting particle's laser source q (W/kg) in heat.w.
+fn write_source(pr: &Params, st: &mut State, q: &[f32]) {
+    let phase = &st.phase;
+    for (i, hv) in st.heat.iter_mut().enumerate() {
+        if pr.conducts(phase[i]) {
+            hv[3] = q[i];
+        }
+    }
+}
+
 pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
     let nb = pr.laser_bins;
     let dim = pr.counts[2] as usize;
@@ -125,8 +150,8 @@ pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
     let stride = if dim == 3 { nx * ny } else { nx };
     let centre = beam_centre(pr, t);
     let power = beam_power(pr, t);
-    let [zeta, rw, a, _] = pr.laser;
-    let [dx, peak, vbin, area] = pr.laser_grid;
+    let a = pr.laser[2];
+    let [dx, _, vbin, area] = pr.laser_grid;
     let out: Vec<Vec<(usize, f32)>> = (0..n_cols)
         .into_par_iter()
         .map(|c| {
@@ -138,10 +163,7 @@ pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
                     0,
                 ],
             );
-            let d0 = top[0] - centre[0];
-            let d1 = if dim == 3 { top[1] - centre[1] } else { 0.0 };
-            let r2 = d0 * d0 + d1 * d1;
-            let mut i = zeta * power * peak * pm_exp(-(2.0 * r2 / (rw * rw))) * area;
+            let mut i = irradiance(pr, &top, centre, power) * area;
             let mut col = Vec::with_capacity(depth);
             for k in (0..depth).rev() {
                 let b = c + k * stride;
@@ -195,9 +217,7 @@ pub fn deposit(pr: &Params, st: &mut State, bins: &[[f32; 2]]) {
             sum / mass[i]
         })
         .collect();
-    for (i, hv) in st.heat.iter_mut().enumerate() {
-        hv[3] = q[i];
-    }
+    write_source(pr, st, &q);
 }
 
 /// Bin coordinates wrapped on periodic axes; None outside the grid.
@@ -222,8 +242,6 @@ pub fn surface(pr: &Params, st: &mut State) {
     let up = pr.counts[2] as usize - 1;
     let centre = beam_centre(pr, st.sim.time);
     let power = beam_power(pr, st.sim.time);
-    let [zeta, rw, _, _] = pr.laser;
-    let peak = pr.laser_grid[1];
     let (pos, phase, surf) = (&st.pos, &st.phase, &st.surface);
     let q: Vec<f32> = (0..n)
         .into_par_iter()
@@ -231,18 +249,10 @@ pub fn surface(pr: &Params, st: &mut State) {
             if !absorbs(pr, phase[i]) {
                 return 0.0;
             }
-            let p = pos[i];
-            let d0 = p[0] - centre[0];
-            let d1 = if up == 2 { p[1] - centre[1] } else { 0.0 };
-            let r2 = d0 * d0 + d1 * d1;
-            let irradiance = zeta * power * peak * pm_exp(-(2.0 * r2 / (rw * rw)));
             let cos = surf[i][up].max(0.0);
-            irradiance * cos * surf[i][3] / pr.phase_a[phase[i] as usize][0]
+            irradiance(pr, &pos[i], centre, power) * cos * surf[i][3]
+                / pr.phase_a[phase[i] as usize][0]
         })
         .collect();
-    for (i, hv) in st.heat.iter_mut().enumerate() {
-        if pr.conducts(phase[i]) {
-            hv[3] = q[i];
-        }
-    }
+    write_source(pr, st, &q);
 }

@@ -213,12 +213,9 @@ fn neighbor_cell_index(ci: vec3<i32>, off: vec3<i32>) -> i32 {
 
 // Start and end of the sorted particles in neighbour cell ci + off (empty if outside).
 fn neighbor_cell(ci: vec3<i32>, off: vec3<i32>) -> vec2<u32> {
-    let cx = wrap_cell(ci.x + off.x, 0u);
-    let cy = wrap_cell(ci.y + off.y, 1u);
-    let cz = wrap_cell(ci.z + off.z, 2u);
-    if (cx < 0 || cy < 0 || cz < 0) { return vec2<u32>(0u, 0u); }
-    let c = u32(cx) + P.grid.x * (u32(cy) + P.grid.y * u32(cz));
-    return vec2<u32>(cell_start[c], cell_end[c]);
+    let c = neighbor_cell_index(ci, off);
+    if (c < 0) { return vec2<u32>(0u, 0u); }
+    return vec2<u32>(cell_start[u32(c)], cell_end[u32(c)]);
 }
 
 // d = r_i - r_j with the minimum image on periodic axes.

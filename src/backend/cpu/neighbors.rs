@@ -18,6 +18,14 @@ pub struct CellTable {
 /// True if any cell the neighbour loop of point `pi` visits holds fluid.
 #[inline(always)]
 pub fn fluid_nearby(pr: &Params, grid: &CellTable, pi: &[f32; 4]) -> bool {
+    !for_each_cell(pr, pi, |c| !grid.fluid[c])
+}
+
+/// Visit the cells the neighbour loop of point `pi` covers, in its fixed order
+/// (dz, dy, dx from −1 to 1; wrapped on periodic axes, skipped outside the grid),
+/// until `f` returns false. Returns false if it stopped early.
+#[inline(always)]
+fn for_each_cell(pr: &Params, pi: &[f32; 4], mut f: impl FnMut(usize) -> bool) -> bool {
     let ci = cell_coord(pr, pi);
     let zr = if pr.counts[2] == 3 { 1 } else { 0 };
     let flags = pr.grid[3];
@@ -33,13 +41,13 @@ pub fn fluid_nearby(pr: &Params, grid: &CellTable, pi: &[f32; 4]) -> bool {
                 let Some(cx) = wrap(ci[0] + dx, pr.grid[0], flags & 1 != 0) else {
                     continue;
                 };
-                if grid.fluid[(cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize] {
-                    return true;
+                if !f((cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize) {
+                    return false;
                 }
             }
         }
     }
-    false
+    true
 }
 
 /// Integer cell coordinates of a position, clamped into the grid.
@@ -82,32 +90,16 @@ pub fn for_each_near(
     pi: [f32; 4],
     mut f: impl FnMut(usize, [f32; 3], f32),
 ) {
-    let ci = cell_coord(pr, &pi);
-    let zr = if pr.counts[2] == 3 { 1 } else { 0 };
-    let flags = pr.grid[3];
-    for dz in -zr..=zr {
-        let Some(cz) = wrap(ci[2] + dz, pr.grid[2], flags & 4 != 0) else {
-            continue;
-        };
-        for dy in -1..=1 {
-            let Some(cy) = wrap(ci[1] + dy, pr.grid[1], flags & 2 != 0) else {
-                continue;
-            };
-            for dx in -1..=1 {
-                let Some(cx) = wrap(ci[0] + dx, pr.grid[0], flags & 1 != 0) else {
-                    continue;
-                };
-                let c = (cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize;
-                for j in grid.start[c] as usize..grid.end[c] as usize {
-                    let d = min_image(pr, pi, pos[j]);
-                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    if r2 < pr.kernel[3] {
-                        f(j, d, r2);
-                    }
-                }
+    for_each_cell(pr, &pi, |c| {
+        for j in grid.start[c] as usize..grid.end[c] as usize {
+            let d = min_image(pr, pi, pos[j]);
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if r2 < pr.kernel[3] {
+                f(j, d, r2);
             }
         }
-    }
+        true
+    });
 }
 
 /// d = a − b with the minimum image on periodic axes.

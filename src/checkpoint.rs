@@ -10,6 +10,7 @@
 
 use crate::error::InputError;
 use crate::model::Model;
+use crate::output::write_atomic;
 use crate::state::{Sim, State};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -213,11 +214,4 @@ impl CheckpointSink {
         }
         Ok(path)
     }
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
 }

@@ -345,6 +345,15 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
     schema
 }
 
+/// Write a file under a temporary name and rename it: a run stopped at any moment
+/// leaves either the old file or the complete new one.
+pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
 /// Simulated time in nanoseconds, the MCAP log time of a frame.
 pub fn time_ns(t: f64) -> u64 {
     (t.max(0.0) * 1e9).round() as u64

@@ -3,11 +3,11 @@
 //! collection with the simulated times. Both are written to a temporary name and
 //! renamed, so a run stopped at any moment leaves only complete files.
 
-use super::{particle_fields, Field, Values};
+use super::{particle_fields, write_atomic, Field, Values};
 use crate::model::Model;
 use crate::state::State;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub const COLLECTION: &str = "particles.pvd";
 
@@ -43,13 +43,6 @@ impl VtkSink {
             pvd_text(&self.frames).as_bytes(),
         )
     }
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
 fn pvd_text(frames: &[(f64, String)]) -> String {

@@ -16,7 +16,7 @@ fn volume(j: u32) -> f32 {
 fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     let n = P.counts.x;
-    if (i >= n || P.iface.z != 0.0) { return; }
+    if (i >= n) { return; }
     var g = 0.0;
     if (condensed(phase[i])) {
         let pi = pos[i];

@@ -306,7 +306,10 @@ impl GpuBackend {
             Stage::Neighbors => self.encode_neighbors(enc, idx),
             Stage::Interface => {
                 let mut pass = self.begin_pass(enc, stage, idx);
-                self.dispatch(&mut pass, "shepard", n);
+                // F22's gas-interface form needs no Shepard sums.
+                if self.params.interface[2] == 0.0 {
+                    self.dispatch(&mut pass, "shepard", n);
+                }
                 self.dispatch(&mut pass, "normals", n);
             }
             Stage::Laser if self.params.laser[3] == LASER_SURFACE => {

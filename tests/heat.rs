@@ -4,52 +4,71 @@
 mod common;
 use common::{scene, spatter, text};
 
-/// Run a scene on the CPU; return the check's value and print its lines.
-fn check_value(name: &str, sets: &[&str]) -> (f64, bool) {
-    let mut args = vec!["run", "--backend", "cpu"];
-    let path = scene(name);
-    args.push(&path);
+/// `spatter ARGS... --set S...`: exit code and output.
+fn spatter_with(args: &[&str], sets: &[&str]) -> (Option<i32>, String) {
+    let mut args = args.to_vec();
     for s in sets {
         args.extend_from_slice(&["--set", s]);
     }
     let out = spatter(&args);
     let (stdout, stderr) = text(&out);
-    let line = stdout
-        .lines()
-        .find(|l| l.starts_with("check "))
-        .unwrap_or_else(|| panic!("no check line: {stdout}{stderr}"));
-    println!("{name} {sets:?}\n{stdout}");
-    let value: f64 = line
-        .split(" = ")
+    (out.status.code(), format!("{stdout}{stderr}"))
+}
+
+/// `spatter run --backend cpu PATH EXTRA... --set S...`.
+fn run_cpu(path: &str, extra: &[&str], sets: &[&str]) -> (Option<i32>, String) {
+    let mut args = vec!["run", "--backend", "cpu", path];
+    args.extend_from_slice(extra);
+    spatter_with(&args, sets)
+}
+
+/// The number after `label` in `line` (up to a space or comma).
+fn figure(line: &str, label: &str) -> f64 {
+    let rest = line
+        .split(label)
         .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+        .unwrap_or_else(|| panic!("no `{label}` in {line}"));
+    rest.split([' ', ',']).next().unwrap().parse().unwrap()
+}
+
+/// The line of a run's output that starts with `prefix`.
+fn line_of<'a>(output: &'a str, prefix: &str) -> &'a str {
+    output
+        .lines()
+        .find(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("no `{prefix}` line: {output}"))
+}
+
+/// Run a scene on the CPU; return the check's value and whether it passed.
+fn check_value(name: &str, sets: &[&str]) -> (f64, bool) {
+    let (code, output) = run_cpu(&scene(name), &[], sets);
+    println!("{name} {sets:?}\n{output}");
+    let line = line_of(&output, "check ");
     (
-        value,
-        line.ends_with("PASS") && out.status.code() == Some(0),
+        figure(line, " = "),
+        line.ends_with("PASS") && code == Some(0),
     )
+}
+
+/// The scene's check passes and its value is at most `limit`.
+fn assert_check(name: &str, sets: &[&str], limit: f64) {
+    let (v, pass) = check_value(name, sets);
+    assert!(pass && v <= limit, "{name} {sets:?}: {v} (limit {limit})");
 }
 
 #[test]
 fn conduction_1d_within_1_percent_of_erf() {
-    let (v, pass) = check_value("conduction_1d", &[]);
-    assert!(pass && v <= 0.01, "{v}");
+    assert_check("conduction_1d", &[], 0.01);
 }
 
 #[test]
 fn two_materials_steady_profile_within_1_percent() {
-    let (v, pass) = check_value("conduction_two_materials", &[]);
-    assert!(pass && v <= 0.01, "{v}");
+    assert_check("conduction_two_materials", &[], 0.01);
 }
 
 #[test]
 fn adiabatic_box_conserves_enthalpy_to_1e_6_over_1e4_steps() {
-    let (v, pass) = check_value("adiabatic_box", &[]);
-    assert!(pass && v <= 1e-6, "{v}");
+    assert_check("adiabatic_box", &[], 1e-6);
 }
 
 /// Issue 4: Stefan front within 3% at the finest of three resolutions, the error
@@ -66,19 +85,9 @@ fn stefan_front_converges_and_is_within_3_percent() {
 }
 
 fn passes(name: &str, sets: &[&str]) -> String {
-    let path = scene(name);
-    let mut args = vec!["validate", path.as_str()];
-    for s in sets {
-        args.extend_from_slice(&["--set", s]);
-    }
-    let out = spatter(&args);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
-    stdout
-        .lines()
-        .find(|l| l.starts_with("passes: "))
-        .unwrap()
-        .to_string()
+    let (code, output) = spatter_with(&["validate", &scene(name)], sets);
+    assert_eq!(code, Some(0), "{output}");
+    line_of(&output, "passes: ").to_string()
 }
 
 #[test]
@@ -118,15 +127,14 @@ fn conduction_limit_binds_and_is_named() {
 /// surface model, all three kernels: the surface-delta normalisation κ differs).
 #[test]
 fn laser_flat_plate_absorbs_zeta_p_within_1_percent() {
-    let (v, pass) = check_value("laser_flat_plate", &[]);
-    assert!(pass && v <= 0.01, "beer_lambert: {v}");
+    assert_check("laser_flat_plate", &[], 0.01);
     for kernel in ["quintic", "wendland_c2", "cubic"] {
         let k = format!("kernel=\"{kernel}\"");
-        let (v, pass) = check_value(
+        assert_check(
             "laser_flat_plate",
             &["laser.model=\"gaussian_surface\"", &k],
+            0.01,
         );
-        assert!(pass && v <= 0.01, "gaussian_surface, {kernel}: {v}");
     }
 }
 
@@ -152,10 +160,8 @@ fn melt_block_3d_energy_balance_and_resolidification() {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("heat_melt_block");
     let _ = std::fs::create_dir_all(&dir);
     let mcap = dir.join("m.mcap");
-    let (v, pass) = check_value("melt_block_3d", &[]);
-    assert!(pass && v <= 0.01, "gaussian_surface: {v}");
-    let (v, pass) = check_value("melt_block_3d", &["laser.model=\"beer_lambert\""]);
-    assert!(pass && v <= 0.01, "beer_lambert: {v}");
+    assert_check("melt_block_3d", &[], 0.01);
+    assert_check("melt_block_3d", &["laser.model=\"beer_lambert\""], 0.01);
     let out = spatter(&[
         "run",
         "--backend",
@@ -191,25 +197,9 @@ fn radiation_loss_balances_and_matches_the_flat_surface_flux() {
         "materials.steel.emissivity=1.0",
         "laser.model=\"gaussian_surface\"",
     ];
-    let (v, pass) = check_value("laser_flat_plate", &sets);
-    assert!(pass && v <= 0.01, "{v}");
-    let path = scene("laser_flat_plate");
-    let mut args = vec!["run", "--backend", "cpu", path.as_str(), "--steps", "1"];
-    for s in &sets {
-        args.extend_from_slice(&["--set", s]);
-    }
-    let out = spatter(&args);
-    let (stdout, _) = text(&out);
-    let line = stdout.lines().find(|l| l.starts_with("heat: ")).unwrap();
-    let radiated: f64 = line
-        .split("radiated ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    assert_check("laser_flat_plate", &sets, 0.01);
+    let (_, output) = run_cpu(&scene("laser_flat_plate"), &["--steps", "1"], &sets);
+    let radiated = figure(line_of(&output, "heat: "), "radiated ");
     let ideal = 5.670374419e-8 * (2000f64.powi(4) - 300f64.powi(4)) * 4.0e-4;
     assert!(
         (radiated / ideal - 1.0).abs() < 0.02,
@@ -221,15 +211,13 @@ fn radiation_loss_balances_and_matches_the_flat_surface_flux() {
 /// quasi-steady solution (window and normalisation in heat_checks::rosenthal).
 #[test]
 fn rosenthal_scan_line_within_5_percent() {
-    let (v, pass) = check_value("rosenthal_2d", &[]);
-    assert!(pass && v <= 0.05, "{v}");
+    assert_check("rosenthal_2d", &[], 0.05);
 }
 
 /// The surface flux through the condensed–gas interface of F22 (19)–(20).
 #[test]
 fn laser_through_the_gas_interface_within_1_percent() {
-    let (v, pass) = check_value("laser_plate_under_gas_2d", &[]);
-    assert!(pass && v <= 0.01, "{v}");
+    assert_check("laser_plate_under_gas_2d", &[], 0.01);
 }
 
 /// Viscous heating (R18 (3.43)–(3.44) role, written as the power the F22 (23)
@@ -292,27 +280,9 @@ fn line_melt_example_runs_at_its_quick_look_resolution() {
         "{}/scenarios/pbf/line_melt_bare_plate.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    let out = spatter(&[
-        "run",
-        "--backend",
-        "cpu",
-        &path,
-        "--set",
-        "dx=2e-5",
-        "--until",
-        "1.2e-4",
-    ]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
-    let line = stdout.lines().find(|l| l.starts_with("heat: ")).unwrap();
-    let melted: f64 = line
-        .split("melted volume ")
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let (code, output) = run_cpu(&path, &["--until", "1.2e-4"], &["dx=2e-5"]);
+    assert_eq!(code, Some(0), "{output}");
+    let line = line_of(&output, "heat: ");
+    let melted = figure(line, "melted volume ");
     assert!(melted > 0.0, "{line}");
 }

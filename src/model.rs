@@ -40,17 +40,8 @@ pub struct Thermal {
     pub mushy_damping: f64,
 }
 
-/// F22 (10), (18) constants, validated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Evaporation {
-    pub pressure_constant: f64,
-    pub temperature_constant: f64,
-    pub boiling_temperature: f64,
-    pub latent_heat: f64,
-    pub enthalpy_reference: f64,
-    pub vapor_constant: f64,
-    pub sticking: f64,
-}
+/// F22 (10), (18) constants: the scenario's table, once validated.
+pub use crate::scene::EvaporationDef as Evaporation;
 
 impl Evaporation {
     /// Recoil pressure p_v(T) F22 (10).
@@ -663,18 +654,14 @@ fn thermal_table(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
             Some(_) if ph.kind != PhaseKind::Liquid => None,
             Some(e) => {
                 let k = |n: &str| mkey(&format!("evaporation.{n}"));
-                Some(Evaporation {
-                    pressure_constant: cx.positive(&k("pressure_constant"), e.pressure_constant)?,
-                    temperature_constant: cx
-                        .positive(&k("temperature_constant"), e.temperature_constant)?,
-                    boiling_temperature: cx
-                        .positive(&k("boiling_temperature"), e.boiling_temperature)?,
-                    latent_heat: cx.positive(&k("latent_heat"), e.latent_heat)?,
-                    enthalpy_reference: cx
-                        .non_negative(&k("enthalpy_reference"), e.enthalpy_reference)?,
-                    vapor_constant: cx.positive(&k("vapor_constant"), e.vapor_constant)?,
-                    sticking: cx.positive(&k("sticking"), e.sticking)?,
-                })
+                cx.positive(&k("pressure_constant"), e.pressure_constant)?;
+                cx.positive(&k("temperature_constant"), e.temperature_constant)?;
+                cx.positive(&k("boiling_temperature"), e.boiling_temperature)?;
+                cx.positive(&k("latent_heat"), e.latent_heat)?;
+                cx.non_negative(&k("enthalpy_reference"), e.enthalpy_reference)?;
+                cx.positive(&k("vapor_constant"), e.vapor_constant)?;
+                cx.positive(&k("sticking"), e.sticking)?;
+                Some(*e)
             }
         };
         let emissivity = match mat.emissivity {

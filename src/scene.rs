@@ -229,7 +229,7 @@ pub struct Material {
 
 /// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),
 /// loss per area ṁ (h_v + c_p (T − T_h0)).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EvaporationDef {
     /// C_p (Pa).

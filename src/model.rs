@@ -2,7 +2,9 @@
 //! sense, plus the host-side time-step limits (F22 (42)).
 
 use crate::error::InputError;
-use crate::scene::{CheckDef, Formulation, KernelKind, PhaseKind, SceneFile, Slip, WatchdogDef};
+use crate::scene::{
+    CheckDef, Formulation, InitialPressure, KernelKind, PhaseKind, SceneFile, Slip, WatchdogDef,
+};
 
 #[derive(Debug, Clone)]
 pub struct PhaseInfo {
@@ -158,6 +160,8 @@ pub struct Model {
     pub gravity: [f64; 3],
     pub background_pressure: f64,
     pub pressure_floor: bool,
+    /// Gravity axis when the fluid starts hydrostatic (`simulation.initial_pressure`).
+    pub hydrostatic_axis: Option<usize>,
     pub viscous_heating: bool,
     pub ambient_temperature: f64,
     pub jitter: f64,
@@ -302,6 +306,10 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     }
 
     let (domain_lo, domain_hi, periodic) = domain_box(&cx, scene, dim)?;
+    let hydrostatic_axis = match sim.initial_pressure {
+        InitialPressure::Zero => None,
+        InitialPressure::Hydrostatic => Some(hydrostatic_axis(&cx, gravity, periodic)?),
+    };
     let phases = phase_table(&cx, scene, dim, dx)?;
     let wall_layers = (support / dx - 1e-9).ceil() as u32;
     let (origin, grid, cell_size) = cell_grid(
@@ -434,6 +442,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         ambient_temperature: cx
             .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
         pressure_floor: sim.pressure_floor,
+        hydrostatic_axis,
         jitter: sim.jitter,
         seed: sim.seed,
         phases,
@@ -471,6 +480,28 @@ fn domain_box(
         periodic[..dim as usize].copy_from_slice(&scene.domain.periodic);
     }
     Ok((lo, hi, periodic))
+}
+
+/// The axis a hydrostatic start stacks the fluid along: gravity must point along
+/// exactly one axis, and that axis must not be periodic (no top to hang from).
+fn hydrostatic_axis(cx: &Ctx, gravity: [f64; 3], periodic: [bool; 3]) -> Result<usize, InputError> {
+    let key = "simulation.initial_pressure";
+    let axes: Vec<usize> = (0..3).filter(|&a| gravity[a] != 0.0).collect();
+    let &[a] = axes.as_slice() else {
+        return Err(cx.err(
+            key,
+            format!(
+                "\"hydrostatic\" needs simulation.gravity along exactly one axis (got {gravity:?})"
+            ),
+        ));
+    };
+    if periodic[a] {
+        return Err(cx.err(
+            key,
+            format!("\"hydrostatic\" needs a non-periodic gravity axis (axis {a} is periodic)"),
+        ));
+    }
+    Ok(a)
 }
 
 fn phase_table(

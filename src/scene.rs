@@ -73,6 +73,17 @@ pub enum Slip {
     FreeSlip,
 }
 
+/// Pressure the fluid starts with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialPressure {
+    /// p = 0 everywhere: a column at rest first sinks and rings acoustically.
+    #[default]
+    Zero,
+    /// The weight of the fluid above each particle (setup.rs `hydrostatic_start`).
+    Hydrostatic,
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -138,6 +149,10 @@ pub struct Simulation {
     /// where summation density is deficient near the surface (PHYSICS.md §2a).
     #[serde(default)]
     pub pressure_floor: bool,
+    /// `zero` (default) or `hydrostatic`: start each fluid particle at the pressure
+    /// of the fluid above it, so a layer at rest starts in equilibrium.
+    #[serde(default)]
+    pub initial_pressure: InitialPressure,
     /// Seeded random displacement of fluid particles, as a fraction of Δx.
     #[serde(default)]
     pub jitter: f64,
@@ -361,8 +376,22 @@ pub struct CheckDef {
     pub surface: Option<f64>,
     /// Dam break: initial column width L.
     pub column_width: Option<f64>,
+    /// Dam break: the experiment the metric compares with (default Koshizuka & Oka).
+    #[serde(default)]
+    pub experiment: DamBreakExperiment,
     /// Hydrostatic: particles closer than this to the free surface are excluded (m).
     pub exclude_depth: Option<f64>,
+}
+
+/// Surge-front data for a column of width L and height 2L (checks.rs holds the tables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DamBreakExperiment {
+    /// Koshizuka & Oka (1996), L = 0.146 m.
+    #[default]
+    KoshizukaOka,
+    /// Martin & Moyce (1952), n² = 2, a = 2.25 in.
+    MartinMoyce,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

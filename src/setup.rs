@@ -244,9 +244,11 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     let axes: Vec<Vec<(f64, bool)>> = (0..3).map(|a| axis_sites(m, a)).collect();
     let mut rng = SplitMix(m.seed);
     let mut st = State::default();
-    for &(z, wz) in &axes[2] {
-        for &(y, wy) in &axes[1] {
-            for &(x, wx) in &axes[0] {
+    // Lattice index of every particle, for the hydrostatic start's columns.
+    let mut sites: Vec<[u32; 3]> = Vec::new();
+    for (iz, &(z, wz)) in axes[2].iter().enumerate() {
+        for (iy, &(y, wy)) in axes[1].iter().enumerate() {
+            for (ix, &(x, wx)) in axes[0].iter().enumerate() {
                 let p = [x, y, z];
                 let phase = if wx || wy || wz {
                     wall_phase_at(m, scene, p)
@@ -267,6 +269,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                     }
                 }
                 push_particle(m, &mut st, q, pi);
+                sites.push([ix as u32, iy as u32, iz as u32]);
             }
         }
     }
@@ -277,10 +280,60 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     {
         return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid or solid particle (no shape of a liquid, gas or solid phase covers a lattice site)"));
     }
+    if let Some(axis) = m.hydrostatic_axis {
+        hydrostatic_start(m, &mut st, &sites, axis);
+    }
     if m.needs_interface() {
         st.surface = vec![[0.0; 4]; 2 * st.len()];
     }
     Ok(st)
+}
+
+/// Hydrostatic start: each fluid particle begins at the pressure of the fluid
+/// stacked above it along gravity,
+///   p_i = Σ_{j above} ρ0_j |g| Δx + ½ ρ0_i |g| Δx,
+/// counting contiguous fluid lattice sites up to the first empty, wall or solid site
+/// (a wall or a gap carries the load above it). Its mass is scaled by
+/// 1 + p_i/(ρ0_i c_i²): summation density ρ_i = m_i Σ_j W_ij then gives that pressure
+/// through the EOS on the lattice. Without this a layer at rest starts at p = 0,
+/// sinks by g H/c² of its height and rings acoustically; at density ratio 1000 that
+/// start-up transient pushes liquid particles through a liquid–gas interface.
+fn hydrostatic_start(m: &Model, st: &mut State, sites: &[[u32; 3]], axis: usize) {
+    let g = m.gravity[axis].abs();
+    // Walk each column from the top down: "top" is the far end against gravity.
+    let height = |i: usize| -> i64 {
+        let k = sites[i][axis] as i64;
+        if m.gravity[axis] < 0.0 {
+            -k
+        } else {
+            k
+        }
+    };
+    let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+    let mut order: Vec<usize> = (0..st.len()).collect();
+    order.sort_by_key(|&i| (sites[i][b], sites[i][c], height(i)));
+    let mut load = 0.0f64;
+    let mut prev: Option<usize> = None;
+    for &i in &order {
+        let contiguous = prev.is_some_and(|j| {
+            sites[j][b] == sites[i][b] && sites[j][c] == sites[i][c] && height(i) == height(j) + 1
+        });
+        prev = Some(i);
+        let ph = &m.phases[st.phase[i] as usize];
+        if !contiguous || !ph.is_fluid() {
+            load = 0.0;
+        }
+        if !ph.is_fluid() {
+            continue;
+        }
+        let weight = ph.rho0 * g * m.dx;
+        let p = load + 0.5 * weight;
+        load += weight;
+        let compression = p / (ph.rho0 * ph.sound_speed * ph.sound_speed);
+        st.mass[i] = (ph.mass * (1.0 + compression)) as f32;
+        st.rho[i] = (ph.rho0 * (1.0 + compression)) as f32;
+        st.p[i] = p as f32;
+    }
 }
 
 fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {

@@ -52,11 +52,79 @@ fn two_layer_no_crossing_and_continuous_pressure() {
     check_passes("two_layer_2d");
 }
 
-/// Fails today: the front runs ahead of Koshizuka & Oka (1996) by up to 18.6% at
-/// T = 2.5 (within 10% only up to T ≈ 1.2), see the note on issue 2. Kept at the
-/// issue's 10% tolerance rather than widened; run with `--ignored` to see it.
+/// The hydrostatic start (`simulation.initial_pressure = "hydrostatic"`) stacks the
+/// two layers of two_layer_2d: every fluid particle starts at the weight of the
+/// fluid above it, p = ρ_g g (0.2 − 0.1) + ρ_l g (0.1 − y) in the liquid, and its
+/// mass is scaled so the EOS returns that pressure. The expected values are
+/// computed here from the lattice (sites at (k + ½)Δx), independently of setup.rs;
+/// 1e-4 relative is f32 rounding of the summed weights.
 #[test]
-#[ignore = "surge front 18.6% ahead of the experiment at T = 2.5 (tolerance 10%)"]
+fn hydrostatic_start_stacks_the_layers() {
+    let l = load(&common::scene("two_layer_2d"), &[]).unwrap();
+    let (m, st) = (&l.model, &l.state);
+    let g = 9.81;
+    let mut checked = 0;
+    for i in 0..st.pos.len() {
+        let ph = &m.phases[st.phase[i] as usize];
+        if !ph.is_fluid() {
+            continue;
+        }
+        let y = st.pos[i][1] as f64 + m.origin[1];
+        let (rho_l, rho_g) = (1000.0, 10.0);
+        let expected = if y > 0.1 {
+            rho_g * g * (0.2 - y)
+        } else {
+            rho_g * g * 0.1 + rho_l * g * (0.1 - y)
+        };
+        let p = st.p[i] as f64;
+        assert!(
+            (p - expected).abs() <= 1e-4 * expected,
+            "particle at y = {y}: p = {p}, expected {expected}"
+        );
+        let c2 = ph.sound_speed * ph.sound_speed;
+        let mass = ph.mass * (1.0 + expected / (ph.rho0 * c2));
+        assert!((st.mass[i] as f64 - mass).abs() <= 1e-6 * mass);
+        checked += 1;
+    }
+    assert_eq!(checked, 20 * 40);
+}
+
+/// Density ratio 1000, issue 2's upper bound: two_layer_2d with an air-like gas
+/// (ρ = 1 kg/m³, c = 316 m/s at the same p0). With the hydrostatic start no particle
+/// crosses the interface; started at p = 0 the settling transient pushed liquid
+/// 6.0 Δx into the gas (measured). The pressure jump is printed, not asserted: the
+/// light gas rings acoustically and the instantaneous jump at t = 0.1 s swings
+/// between 2% and 21% of the liquid head (note on issue 2).
+#[test]
+fn two_layer_ratio_1000_no_crossing() {
+    let sets = ["materials.gas.density=1.0".to_string()];
+    let l = load(&common::scene("two_layer_2d"), &sets).unwrap();
+    let mut b = make_backend(BackendChoice::Cpu, &l, false).unwrap();
+    let opts = RunOptions {
+        end: l.model.end,
+        quiet: true,
+        resumed: false,
+    };
+    let r = run(&l, b.as_mut(), &opts, &mut Outputs::default()).unwrap();
+    let c = r.check.expect("scene has a check");
+    for d in &c.details {
+        println!("{d}");
+    }
+    println!("{}", c.line());
+    assert!(
+        c.metric.starts_with("interface pressure jump"),
+        "particles crossed the interface: {}",
+        c.line()
+    );
+}
+
+/// Fails today: the front runs ahead of Koshizuka & Oka (1996) by up to 19.3% at
+/// T = 2.45 (within 10% up to T ≈ 0.95) and of Martin & Moyce (1952) by up to
+/// 19.2% at T = 1.19. Refining dx 5 → 2.5 → 1.25 mm gives 18.7 → 19.3 → 20.9%, so
+/// it is not discretisation error (note on issue 2). Kept at the issue's 10%
+/// tolerance rather than widened; run with `--ignored` to see it.
+#[test]
+#[ignore = "surge front 19.3% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
 fn dam_break_front_within_10_percent() {
     check_passes("dam_break_2d");
 }

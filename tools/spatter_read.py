@@ -140,6 +140,7 @@ def summary(path):
         "fields": list(frames[0][1].keys()) if frames else [],
         "diagnostics": len(diagnostics),
         "time_span": [min(times), max(times)] if times else [],
+        "first_diagnostics": diagnostics[0] if diagnostics else None,
         "last_diagnostics": diagnostics[-1] if diagnostics else None,
         "diagnostics_max": {k: max(d[k] for d in diagnostics)
                             for k, v in (diagnostics[0].items() if diagnostics else [])

@@ -21,7 +21,7 @@ struct Params {
     phase_g: array<vec4<f32>, 8>, // mushy-zone sink C (1/s), unused
     heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
     laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, model
-    iface: vec4<f32>,             // interface pass: 1/kappa, T_ambient^4, F22 gas mode (1/0), unused
+    iface: vec4<f32>,             // interface pass: 1/kappa, T_ambient^4, F22 gas mode (1/0), alpha_0^lg
     laser_grid: vec4<f32>,        // bin size, peak irradiance per watt, bin volume, column area
     laser_bins: vec4<u32>,        // bins per axis, path points + 256 * power steps
     laser_lo: vec4<f32>,          // bin grid lower corner (grid-relative)

@@ -2,6 +2,17 @@
 // (Adami 2013) and gravity. Twin of src/backend/cpu/forces.rs, which explains the
 // wall treatment.
 
+// F22 (31) for one fluid pair: the factor of r_ij in the force on i (the CPU twin
+// explains the form).
+fn interface_viscosity(m_i: f32, m_j: f32, rho_i: f32, rho_j: f32, c2_i: f32, c2_j: f32,
+                       u: vec3<f32>, d: vec3<f32>, r2: f32, dwdr: f32, alpha: f32) -> f32 {
+    let c = (sqrt(c2_i) + sqrt(c2_j)) * c_half();
+    let rho_m = (rho_i + rho_j) * c_half();
+    let ur = u.x * d.x + u.y * d.y + u.z * d.z;
+    let r = sqrt(r2);
+    return m_i * m_j * alpha * P.kern.x * c / rho_m * ur / (r2 + P.heat.y) * dwdr / r;
+}
+
 @compute @workgroup_size(64)
 fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -23,6 +34,12 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     var fb = vec3<f32>(0.0);
     var heating = 0.0;
     let viscous_heating = (P.grid.w & FLAG_VISCOUS_HEATING) != 0u;
+    let h = P.kern.x;
+    let alpha0 = P.iface.w;
+    var alpha_i = 0.0;
+    if (alpha0 > 0.0) {
+        alpha_i = alpha0 * min(h * surface[i].w, c_one());
+    }
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
@@ -62,6 +79,13 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                             let u = v_i[a] - v_j[a];
                             f[a] = f[a] + vv * (fp * d[a] + fv * u);
                             fb[a] = fb[a] + vv * (fbg * d[a]);
+                        }
+                        if (alpha0 > 0.0 && !wall) {
+                            let alpha = (alpha_i + alpha0 * min(h * surface[j].w, c_one())) * c_half();
+                            let s = interface_viscosity(m_i, m_j, rho_i, rho_j, mat_i.y, mat_j.y, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
+                            for (var a = 0u; a < 3u; a++) {
+                                f[a] = f[a] + s * d[a];
+                            }
                         }
                         if (viscous_heating) {
                             // Power the pair's viscous force dissipates: fluid pairs

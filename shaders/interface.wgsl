@@ -8,6 +8,11 @@ fn condensed(ph: u32) -> bool {
     return P.phase_a[ph].w != KIND_GAS_I;
 }
 
+// Twin of Params::gets_gas_interface.
+fn gets_gas_interface(ph: u32) -> bool {
+    return conducts(ph) || (P.iface.w > 0.0 && !is_wall(ph));
+}
+
 fn volume(j: u32) -> f32 {
     return mass[j] / P.phase_a[phase[j]].x;
 }
@@ -50,7 +55,7 @@ fn vol_density(j: u32) -> f32 {
 // F22 (19)-(20): condensed-gas interface, for scenes with gas particles.
 fn gas_interface(i: u32) {
     let ph = phase[i];
-    if (!conducts(ph)) {
+    if (!gets_gas_interface(ph)) {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }

@@ -162,6 +162,8 @@ pub struct Model {
     pub pressure_floor: bool,
     /// Gravity axis when the fluid starts hydrostatic (`simulation.initial_pressure`).
     pub hydrostatic_axis: Option<usize>,
+    /// F22 (32) α_0^lg (0 = off).
+    pub interface_viscosity: f64,
     pub viscous_heating: bool,
     pub ambient_temperature: f64,
     pub jitter: f64,
@@ -202,7 +204,7 @@ impl Model {
             .laser
             .as_ref()
             .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface);
-        surface_laser || self.has_surface_losses()
+        surface_laser || self.has_surface_losses() || self.interface_viscosity > 0.0
     }
     pub fn has_surface_losses(&self) -> bool {
         self.phases
@@ -340,7 +342,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     let nu_max = fluid
         .iter()
         .map(|p| p.viscosity / p.rho0)
-        .fold(0.0, f64::max);
+        .fold(interface_viscosity_nu(&cx, sim, &fluid, dim, h)?, f64::max);
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
@@ -443,6 +445,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
         pressure_floor: sim.pressure_floor,
         hydrostatic_axis,
+        interface_viscosity: sim.interface_viscosity,
         jitter: sim.jitter,
         seed: sim.seed,
         phases,
@@ -480,6 +483,33 @@ fn domain_box(
         periodic[..dim as usize].copy_from_slice(&scene.domain.periodic);
     }
     Ok((lo, hi, periodic))
+}
+
+/// The kinematic viscosity F22 (31) acts with at most: the artificial-viscosity
+/// term equals a shear viscosity ν = α h c/(2(d + 2)) (Monaghan 2005), and
+/// α = α_0^lg min(h δ, 1) ≤ α_0^lg (backend/cpu/forces.rs), so the viscous limit
+/// 0.125 h²/ν covers it.
+fn interface_viscosity_nu(
+    cx: &Ctx,
+    sim: &crate::scene::Simulation,
+    fluid: &[&PhaseInfo],
+    dim: u32,
+    h: f64,
+) -> Result<f64, InputError> {
+    let key = "simulation.interface_viscosity";
+    let alpha = cx.non_negative(key, sim.interface_viscosity)?;
+    if alpha == 0.0 {
+        return Ok(0.0);
+    }
+    let has = |k: PhaseKind| fluid.iter().any(|p| p.kind == k);
+    if !has(PhaseKind::Liquid) || !has(PhaseKind::Gas) {
+        return Err(cx.err(
+            key,
+            "acts at a liquid–gas interface: the scene needs a liquid and a gas phase",
+        ));
+    }
+    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    Ok(alpha * h * c_max / (2.0 * (dim as f64 + 2.0)))
 }
 
 /// The axis a hydrostatic start stacks the fluid along: gravity must point along

@@ -80,7 +80,7 @@ pub struct Params {
     /// Interface pass: 1/κ, the normalisation of the surface delta (κ = Σ δ V per
     /// unit area across a planar lattice surface, `surface_delta_integral` or
     /// `gas_delta_integral`); T_ambient⁴ for radiation; 1 in F22 gas mode (the
-    /// scene has gas particles); unused.
+    /// scene has gas particles); F22 (32) interface viscosity α_0^lg (0 = off).
     pub interface: [f32; 4],
     /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
     /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
@@ -237,8 +237,11 @@ impl Params {
         };
         if m.needs_interface() {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);
+            // The condensed side of F22's interface: a conducting liquid or solid,
+            // or (interface viscosity without heat) the liquid.
             let condensed = m.phases.iter().find(|ph| {
-                matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid) && ph.conducts()
+                matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid)
+                    && (ph.conducts() || m.interface_viscosity > 0.0)
             });
             let kappa = match (gas, condensed) {
                 (Some(g), Some(c)) => {
@@ -249,6 +252,7 @@ impl Params {
             };
             p.interface[0] = (1.0 / kappa) as f32;
             p.interface[1] = m.ambient_temperature.powi(4) as f32;
+            p.interface[3] = m.interface_viscosity as f32;
         }
         p
     }
@@ -262,6 +266,11 @@ impl Params {
     /// Carries an evolving temperature (liquid, gas or solid in a heat scene).
     pub fn conducts(&self, phase: u32) -> bool {
         self.heat[2] != 0.0 && self.phase_a[phase as usize][3] != KIND_WALL
+    }
+    /// Particles F22's gas-interface pass gives a normal and δ: conducting ones (for
+    /// the surface fluxes) and, with the interface viscosity on, every fluid one.
+    pub fn gets_gas_interface(&self, phase: u32) -> bool {
+        self.conducts(phase) || (self.interface[3] > 0.0 && !self.is_wall(phase))
     }
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phase_d[phase as usize][3] as u32

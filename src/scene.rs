@@ -153,6 +153,10 @@ pub struct Simulation {
     /// of the fluid above it, so a layer at rest starts in equilibrium.
     #[serde(default)]
     pub initial_pressure: InitialPressure,
+    /// F22 (31)–(32) liquid–gas interface viscosity α_0^lg (0 = off; F22 Table 1,
+    /// molten steel: 7.2; Table 4, liquid binder: 1.8). Needs a liquid and a gas phase.
+    #[serde(default)]
+    pub interface_viscosity: f64,
     /// Seeded random displacement of fluid particles, as a fraction of Δx.
     #[serde(default)]
     pub jitter: f64,

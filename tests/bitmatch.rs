@@ -50,6 +50,13 @@ fn two_layer_2d_200_steps() {
     assert_bit_identical("two_layer_2d", &[], 200);
 }
 
+/// F22 (31)–(32) interface viscosity at density ratio 1000, 2D and 3D.
+#[test]
+fn interface_viscosity_ratio_1000_200_steps() {
+    assert_bit_identical("two_layer_ratio1000_2d", &[], 200);
+    assert_bit_identical("two_layer_ratio1000_3d", &[], 200);
+}
+
 #[test]
 fn couette_2d_moving_wall_200_steps() {
     assert_bit_identical("couette_2d", &[], 200);

@@ -11,7 +11,8 @@
 //! over condensed neighbours j, V = m/ρ0. Stored for liquid and solid particles.
 //!
 //! With gas particles in the scene the interface is the condensed–gas one of
-//! F22 (19)–(20) instead, for every conducting particle i over neighbours j of the
+//! F22 (19)–(20) instead, for every conducting particle i (every fluid particle
+//! with the interface viscosity on, `Params::gets_gas_interface`) over neighbours j of the
 //! other class (condensed: liquid, solid, wall; or gas):
 //!   ∇c_i = (1/V_i) Σ_j (V_i² + V_j²) ρ_i/(ρ_i + ρ_j) ∂W/∂r e_ij,
 //!   δ_i = |∇c_i|/κ_F22,  n_i = ∇c_i/|∇c_i| (outward with respect to i's phase),
@@ -104,7 +105,7 @@ fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
     let normals: Vec<[f32; 4]> = (0..n)
         .into_par_iter()
         .map(|i| {
-            if !pr.conducts(phase[i]) {
+            if !pr.gets_gas_interface(phase[i]) {
                 return [0.0; 4];
             }
             let side = condensed(pr, phase[i]);

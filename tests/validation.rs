@@ -4,25 +4,27 @@
 mod common;
 use spatter::run::{load, make_backend, run, BackendChoice, Outputs, RunOptions};
 
-fn check_passes(name: &str) -> f64 {
-    let l = load(&common::scene(name), &[]).unwrap();
+/// Runs a scene on the CPU with `--set` overrides and prints its check's lines.
+fn run_check(name: &str, sets: &[&str]) -> spatter::checks::CheckResult {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let l = load(&common::scene(name), &sets).unwrap();
     let mut b = make_backend(BackendChoice::Cpu, &l, false).unwrap();
-    let r = run(
-        &l,
-        b.as_mut(),
-        &RunOptions {
-            end: l.model.end,
-            quiet: true,
-            resumed: false,
-        },
-        &mut Outputs::default(),
-    )
-    .unwrap();
+    let opts = RunOptions {
+        end: l.model.end,
+        quiet: true,
+        resumed: false,
+    };
+    let r = run(&l, b.as_mut(), &opts, &mut Outputs::default()).unwrap();
     let c = r.check.expect("scene has a check");
     for d in &c.details {
         println!("{d}");
     }
     println!("{}", c.line());
+    c
+}
+
+fn check_passes(name: &str) -> f64 {
+    let c = run_check(name, &[]);
     assert!(c.pass, "{}", c.line());
     c.value
 }
@@ -98,20 +100,7 @@ fn hydrostatic_start_stacks_the_layers() {
 /// two_layer_ratio1000_2d adds F22's interface viscosity and meets 5%.
 #[test]
 fn two_layer_ratio_1000_no_crossing() {
-    let sets = ["materials.gas.density=1.0".to_string()];
-    let l = load(&common::scene("two_layer_2d"), &sets).unwrap();
-    let mut b = make_backend(BackendChoice::Cpu, &l, false).unwrap();
-    let opts = RunOptions {
-        end: l.model.end,
-        quiet: true,
-        resumed: false,
-    };
-    let r = run(&l, b.as_mut(), &opts, &mut Outputs::default()).unwrap();
-    let c = r.check.expect("scene has a check");
-    for d in &c.details {
-        println!("{d}");
-    }
-    println!("{}", c.line());
+    let c = run_check("two_layer_2d", &["materials.gas.density=1.0"]);
     assert!(
         c.metric.starts_with("interface pressure jump"),
         "particles crossed the interface: {}",

@@ -34,9 +34,10 @@ const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
-const ENTRY_POINTS: [(&str, &str, &str); 20] = [
+pub const ENTRY_POINTS: [(&str, &str, &str); 21] = [
     ("cell_keys", "neighbors", "cell_keys"),
-    ("bitonic", "neighbors", "bitonic"),
+    ("bitonic_global", "neighbors", "bitonic_global"),
+    ("bitonic_local", "neighbors", "bitonic_local"),
     ("reorder", "neighbors", "reorder"),
     ("cell_bounds", "neighbors", "cell_bounds"),
     ("density", "density", "density"),
@@ -91,7 +92,7 @@ pub struct GpuBackend {
     pipeline: Pipeline,
     n: u32,
     n_pad: u32,
-    n_sort_stages: u32,
+    sort_steps: Vec<SortStep>,
     buf: Buffers,
     bind: wgpu::BindGroup,
     sort_bind: wgpu::BindGroup,
@@ -137,10 +138,11 @@ impl GpuBackend {
         let heat_bytes = if thermal { v4 } else { 16 };
         let stages = sort_stages(n_pad);
         let mut stage_bytes = vec![0u8; stages.len().max(1) * STAGE_STRIDE as usize];
-        for (k, (j, kk)) in stages.iter().enumerate() {
-            let o = k * STAGE_STRIDE as usize;
-            stage_bytes[o..o + 4].copy_from_slice(&j.to_le_bytes());
-            stage_bytes[o + 4..o + 8].copy_from_slice(&kk.to_le_bytes());
+        for (s, step) in stages.iter().enumerate() {
+            let o = s * STAGE_STRIDE as usize;
+            for (w, word) in step.uniform().iter().enumerate() {
+                stage_bytes[o + 4 * w..o + 4 * w + 4].copy_from_slice(&word.to_le_bytes());
+            }
         }
         let buf = Buffers {
             params: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -222,7 +224,7 @@ impl GpuBackend {
             pipeline,
             n,
             n_pad,
-            n_sort_stages: stages.len() as u32,
+            sort_steps: stages,
             buf,
             bind,
             sort_bind,
@@ -365,10 +367,14 @@ impl GpuBackend {
         {
             let mut pass = self.begin_pass_marked(enc, "neighbors.sort", idx, true, false);
             self.dispatch(&mut pass, "cell_keys", self.n_pad);
-            pass.set_pipeline(&self.pipelines["bitonic"]);
-            let (x, y) = grid_for(self.n_pad.div_ceil(WG));
-            for s in 0..self.n_sort_stages {
-                pass.set_bind_group(1, &self.sort_bind, &[s * STAGE_STRIDE as u32]);
+            for (s, step) in self.sort_steps.iter().enumerate() {
+                let (name, groups) = match step {
+                    SortStep::Global { .. } => ("bitonic_global", (self.n_pad / 2).div_ceil(WG)),
+                    SortStep::Local { .. } => ("bitonic_local", self.n_pad.div_ceil(SORT_BLOCK)),
+                };
+                pass.set_pipeline(&self.pipelines[name]);
+                pass.set_bind_group(1, &self.sort_bind, &[s as u32 * STAGE_STRIDE as u32]);
+                let (x, y) = grid_for(groups);
                 pass.dispatch_workgroups(x, y, 1);
             }
             self.dispatch(&mut pass, "reorder", self.n);
@@ -475,16 +481,48 @@ fn grid_for(groups: u32) -> (u32, u32) {
     }
 }
 
-/// Compare-exchange stages (j, k) of a bitonic sort over n_pad keys.
-fn sort_stages(n_pad: u32) -> Vec<(u32, u32)> {
-    let mut out = Vec::new();
-    let mut k = 2;
+/// Keys per workgroup-memory block of the bitonic sort (twin of neighbors.wgsl).
+const SORT_BLOCK: u32 = 2048;
+
+/// One dispatch of the bitonic sort (neighbors.wgsl).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SortStep {
+    /// Compare-exchange stage (j, k) with j >= SORT_BLOCK, through global memory.
+    Global { j: u32, k: u32 },
+    /// Every stage with j < SORT_BLOCK of k = k_first..=k_last, in workgroup memory.
+    Local { k_first: u32, k_last: u32 },
+}
+
+impl SortStep {
+    /// The SortStage uniform: (j, k, k_last, 0).
+    fn uniform(&self) -> [u32; 4] {
+        match *self {
+            SortStep::Global { j, k } => [j, k, 0, 0],
+            SortStep::Local { k_first, k_last } => [0, k_first, k_last, 0],
+        }
+    }
+}
+
+/// The dispatches of a bitonic sort over n_pad keys (a power of two): all of
+/// k <= SORT_BLOCK at once in workgroup memory, then per larger k its global stages
+/// down to j = SORT_BLOCK and one local dispatch for the rest.
+fn sort_stages(n_pad: u32) -> Vec<SortStep> {
+    let block = SORT_BLOCK.min(n_pad);
+    let mut out = vec![SortStep::Local {
+        k_first: 2,
+        k_last: block,
+    }];
+    let mut k = 2 * block;
     while k <= n_pad {
         let mut j = k / 2;
-        while j > 0 {
-            out.push((j, k));
+        while j >= block {
+            out.push(SortStep::Global { j, k });
             j /= 2;
         }
+        out.push(SortStep::Local {
+            k_first: k,
+            k_last: k,
+        });
         k *= 2;
     }
     out
@@ -582,20 +620,28 @@ fn main_bind_group(
     })
 }
 
+/// Each pass's complete WGSL source (shared definitions and portable math first), by
+/// shader file name. Public so that a test can validate them without an adapter.
+pub fn shader_sources() -> Vec<(&'static str, String)> {
+    SHADERS
+        .iter()
+        .map(|(name, src)| (*name, format!("{COMMON}\n{PORTABLE_MATH}\n{src}")))
+        .collect()
+}
+
 fn build_pipelines(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     sort_layout: &wgpu::BindGroupLayout,
 ) -> HashMap<&'static str, wgpu::ComputePipeline> {
-    let modules: HashMap<&str, wgpu::ShaderModule> = SHADERS
-        .iter()
-        .map(|(name, src)| {
-            let source = format!("{COMMON}\n{PORTABLE_MATH}\n{src}");
+    let modules: HashMap<&str, wgpu::ShaderModule> = shader_sources()
+        .into_iter()
+        .map(|(name, source)| {
             let m = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(name),
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             });
-            (*name, m)
+            (name, m)
         })
         .collect();
     let plain = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -611,7 +657,11 @@ fn build_pipelines(
     ENTRY_POINTS
         .iter()
         .map(|(name, file, entry)| {
-            let pl = if *name == "bitonic" { &sorting } else { &plain };
+            let pl = if name.starts_with("bitonic") {
+                &sorting
+            } else {
+                &plain
+            };
             let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(name),
                 layout: Some(pl),

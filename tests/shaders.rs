@@ -1,0 +1,28 @@
+//! Every WGSL pass parses and validates with naga, the compiler wgpu uses. A broken
+//! shader then fails here with its line and message instead of as a pipeline error
+//! at run time.
+
+use spatter::backend::gpu::{shader_sources, ENTRY_POINTS};
+
+#[test]
+fn every_shader_validates() {
+    let sources = shader_sources();
+    assert!(sources.len() >= 9, "all pass shaders listed");
+    for (name, source) in sources {
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&source)));
+        // Every pipeline the backend builds from this file finds its entry point.
+        for (pipeline, _, entry) in ENTRY_POINTS.iter().filter(|e| e.1 == name) {
+            assert!(
+                module.entry_points.iter().any(|ep| ep.name == *entry),
+                "pipeline {pipeline}: no entry point {entry} in {name}.wgsl"
+            );
+        }
+    }
+}

@@ -218,6 +218,42 @@ fn neighbor_cell(ci: vec3<i32>, off: vec3<i32>) -> vec2<u32> {
     return vec2<u32>(cell_start[u32(c)], cell_end[u32(c)]);
 }
 
+// The neighbour loops visit each (dy, dz) row of cells as segments of sorted
+// particles. Without x-periodicity the row's cells ci.x-1..ci.x+1 (clipped to the
+// grid) have consecutive indices, so their particles are one run of the sorted
+// order: one segment, holding the same particles in the same order as the cell-by-
+// cell walk of the CPU twin (so sums stay bit-identical), with one loop instead of
+// three. A periodic x axis can wrap a cell out of the run: then one segment per cell.
+fn row_segments() -> u32 {
+    if ((P.grid.w & 1u) != 0u) { return 3u; }
+    return 1u;
+}
+
+fn row_segment(ci: vec3<i32>, dy: i32, dz: i32, seg: u32) -> vec2<u32> {
+    if ((P.grid.w & 1u) != 0u) {
+        return neighbor_cell(ci, vec3<i32>(i32(seg) - 1, dy, dz));
+    }
+    let c = neighbor_cell_index(ci, vec3<i32>(0, dy, dz));
+    if (c < 0) { return vec2<u32>(0u, 0u); }
+    let first = u32(c) - select(0u, 1u, ci.x > 0);
+    let last = u32(c) + select(0u, 1u, ci.x + 1 < i32(P.grid.x));
+    // From the first non-empty cell's start to the last non-empty cell's end.
+    var run = vec2<u32>(0u, 0u);
+    var found = false;
+    for (var k = first; k <= last; k++) {
+        let s = cell_start[k];
+        let e = cell_end[k];
+        if (e > s) {
+            if (!found) {
+                run.x = s;
+                found = true;
+            }
+            run.y = e;
+        }
+    }
+    return run;
+}
+
 // d = r_i - r_j with the minimum image on periodic axes.
 fn min_image(pi: vec4<f32>, pj: vec4<f32>) -> vec3<f32> {
     var d = vec3<f32>(pi.x - pj.x, pi.y - pj.y, pi.z - pj.z);

@@ -42,8 +42,8 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     }
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+            for (var seg = 0u; seg < row_segments(); seg++) {
+                let rg = row_segment(ci, dy, dz, seg);
                 for (var j = rg.x; j < rg.y; j++) {
                     let d = min_image(pi, pos[j]);
                     let r2 = len2(d);

@@ -30,8 +30,8 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
     var stw = 0.0;
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+            for (var seg = 0u; seg < row_segments(); seg++) {
+                let rg = row_segment(ci, dy, dz, seg);
                 for (var j = rg.x; j < rg.y; j++) {
                     let r2 = len2(min_image(pi, pos[j]));
                     if (r2 < P.kern.w && conducts(phase[j])) {
@@ -68,8 +68,8 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     var sum = 0.0;
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let rg = neighbor_cell(ci, vec3<i32>(dx, dy, dz));
+            for (var seg = 0u; seg < row_segments(); seg++) {
+                let rg = row_segment(ci, dy, dz, seg);
                 for (var j = rg.x; j < rg.y; j++) {
                     let r2 = len2(min_image(pi, pos[j]));
                     if (r2 >= P.kern.w || r2 <= 0.0) { continue; }

@@ -28,6 +28,7 @@ struct Params {
     laser_path: array<vec4<f32>, 8>,  // time, lateral beam centre
     laser_power: array<vec4<f32>, 8>, // time, power from then on
     consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
+    wall: vec4<f32>,              // wall pass: Shepard weight floor
 }
 
 struct Sim {

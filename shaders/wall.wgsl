@@ -52,13 +52,12 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let b = P.phase_b[ph];
     let m = P.phase_a[ph];
-    var p = 0.0;
-    var v = vec4<f32>(b.x, b.y, b.z, 0.0);
-    if (sw > 0.0) {
-        let g = P.gravity;
-        p = (sp + (g.x * sr.x + g.y * sr.y + g.z * sr.z)) / sw;
-        v = vec4<f32>(c_two() * b.x - sv.x / sw, c_two() * b.y - sv.y / sw, c_two() * b.z - sv.z / sw, 0.0);
-    }
+    // Regularised Shepard division (the CPU twin explains why): as Σ W -> 0 the
+    // pressure goes to 0 and the velocity to the wall's own, continuously.
+    let g = P.gravity;
+    let den = sw + P.wall.x;
+    var p = (sp + (g.x * sr.x + g.y * sr.y + g.z * sr.z)) / den;
+    let v = vec4<f32>(b.x + (b.x * sw - sv.x) / den, b.y + (b.y * sw - sv.y) / den, b.z + (b.z * sw - sv.z) / den, 0.0);
     if ((P.grid.w & FLAG_PRESSURE_FLOOR) != 0u) {
         p = max(p, 0.0);
     }

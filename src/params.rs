@@ -98,7 +98,12 @@ pub struct Params {
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
     /// shaders read every multiplying or adding literal from here.
     pub consts: [[f32; 4]; 8],
+    /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)), unused ×3.
+    pub wall: [f32; 4],
 }
+
+/// The wall pass divides by Σ W + ε with ε this fraction of W(0) (src/backend/cpu/wall.rs).
+pub const WALL_WEIGHT_FLOOR: f64 = 1e-9;
 
 /// Mirrors the `c_*` and portable-math constants in shaders/common.wgsl and
 /// shaders/portable_math.wgsl; src/portable_math.rs uses the same f32 values.
@@ -254,6 +259,7 @@ impl Params {
             p.interface[1] = m.ambient_temperature.powi(4) as f32;
             p.interface[3] = m.interface_viscosity as f32;
         }
+        p.wall[0] = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
         p
     }
     pub fn n(&self) -> usize {

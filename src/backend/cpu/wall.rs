@@ -2,6 +2,7 @@
 //! Each wall particle w gathers from its fluid neighbours f:
 //!   p_w = (Σ p_f W_wf + g·Σ ρ_f r_wf W_wf) / Σ W_wf        (stationary wall, a_w = 0)
 //!   ũ_w = Σ u_f W_wf / Σ W_wf,  u_w = 2 u_wall − ũ_w        (no-slip velocity)
+//! with Σ W_wf + ε as the divisor (see `run`), so u_w = u_wall + (u_wall Σ W − Σ u W)/(Σ W + ε).
 //! The wall's displayed density is its material's EOS inverted at p_w.
 
 use super::neighbors::{fluid_nearby, for_each_neighbor, CellTable};
@@ -58,19 +59,23 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             });
             let b = pr.phase_b[ph as usize];
             let m = pr.phase_a[ph as usize];
-            let (mut p, v) = if sw > 0.0 {
-                let g = pr.gravity;
-                let p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / sw;
-                let v = [
-                    2.0 * b[0] - sv[0] / sw,
-                    2.0 * b[1] - sv[1] / sw,
-                    2.0 * b[2] - sv[2] / sw,
-                    0.0,
-                ];
-                (p, v)
-            } else {
-                (0.0, [b[0], b[1], b[2], 0.0])
-            };
+            // Regularised Shepard division: Σ W + ε instead of Σ W, ε = 1e-9 W(0).
+            // At an exact lattice tie a fluid particle sits at the edge of the
+            // support, where W is 0 or a few ULP above it depending on rounding; a
+            // plain division then jumps between p = 0 (nothing gathered) and a full
+            // extrapolated pressure (tiny/tiny), and a GPU that fuses r² differently
+            // picks the other side. With ε the result goes to 0 continuously as
+            // Σ W -> 0, and for Σ W ≥ 1e-4 W(0) (every fluid neighbour closer than
+            // 2.6h with the quintic) ε changes it by at most 1e-5 relative.
+            let g = pr.gravity;
+            let den = sw + pr.wall[0];
+            let mut p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / den;
+            let v = [
+                b[0] + (b[0] * sw - sv[0]) / den,
+                b[1] + (b[1] * sw - sv[1]) / den,
+                b[2] + (b[2] * sw - sv[2]) / den,
+                0.0,
+            ];
             if pr.grid[3] & FLAG_PRESSURE_FLOOR != 0 {
                 p = p.max(0.0);
             }

@@ -90,3 +90,66 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::neighbors::{self, CellTable};
+    use crate::params::Params;
+    use crate::state::State;
+
+    /// A wall particle of dam_break_2d with one water particle straight above it
+    /// at distance r (pressure 1000 Pa, density 1000, velocity 0.1 m/s along x):
+    /// the wall's pressure and velocity after the wall pass.
+    fn wall_with_one_neighbour(r: f32) -> (f32, [f32; 4], f32) {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/dam_break_2d.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        let water = l.model.phase_index("water").unwrap() as u32;
+        let st0 = &l.state;
+        let w = (0..st0.len()).find(|&i| st0.phase[i] != water).unwrap();
+        let f = (0..st0.len()).find(|&i| st0.phase[i] == water).unwrap();
+        let mut st = State::default();
+        for i in [w, f] {
+            st.pos.push(st0.pos[i]);
+            st.vel.push([0.0; 4]);
+            st.acc.push([0.0; 4]);
+            st.acc_b.push([0.0; 4]);
+            st.rho.push(1000.0);
+            st.p.push(1000.0);
+            st.mass.push(st0.mass[i]);
+            st.phase.push(st0.phase[i]);
+            st.id.push(i as u32);
+        }
+        st.pos[1] = [st.pos[0][0], st.pos[0][1] + r, st.pos[0][2], 0.0];
+        st.vel[1] = [0.1, 0.0, 0.0, 0.0];
+        let pr = Params::new(&l.model, 2);
+        let mut grid = CellTable::default();
+        neighbors::run(&pr, &mut st, &mut grid);
+        super::run(&pr, &mut st, &grid);
+        let k = st.id.iter().position(|&id| id == w as u32).unwrap();
+        (st.p[k], st.vel[k], pr.kernel[3].sqrt())
+    }
+
+    /// Adami's extrapolation p_w = p_f + ρ_f g·(r_w − r_f) with one neighbour well
+    /// inside the support (the weight floor changes it by < 1e-5 relative there),
+    /// and a pressure that falls to 0 continuously at the support's edge instead of
+    /// jumping from the full extrapolated value to 0 (the hardware mismatch the
+    /// floor removes).
+    #[test]
+    fn wall_pressure_is_adami_inside_and_continuous_at_the_support_edge() {
+        let h = 0.0025f32;
+        let (p, v, support) = wall_with_one_neighbour(2.5 * h);
+        let adami = 1000.0 + 1000.0 * 9.81 * 2.5 * h;
+        assert!((p - adami).abs() / adami < 1e-5, "p_w = {p}, Adami {adami}");
+        assert!((v[0] + 0.1).abs() < 1e-6, "no-slip mirror: u_w = {}", v[0]);
+        // Just inside the edge W is a few ULP above 0: p_w is already ~0.
+        let (p_edge, v_edge, _) = wall_with_one_neighbour(support * (1.0 - 1e-6));
+        assert!(p_edge.abs() < 1e-3, "p_w at the edge = {p_edge}");
+        assert!(v_edge[0].abs() < 1e-6, "u_w at the edge = {}", v_edge[0]);
+        // Beyond the support nothing is gathered: exactly the wall's own state.
+        let (p_out, v_out, _) = wall_with_one_neighbour(support * 1.01);
+        assert_eq!((p_out, v_out[0]), (0.0, 0.0));
+    }
+}

@@ -188,7 +188,17 @@ fn field_differences(a: &State, b: &State, scales: &ToleranceScales) -> Vec<Fiel
                 .words
                 .iter()
                 .zip(fb.words)
-                .map(|(&x, &y)| (value(x) as f64 - value(y) as f64).abs())
+                .map(|(&x, &y)| {
+                    let d = (value(x) as f64 - value(y) as f64).abs();
+                    // A NaN on one side must fail, not read as "no difference".
+                    if d.is_nan() && x != y {
+                        f64::INFINITY
+                    } else if x == y {
+                        0.0
+                    } else {
+                        d
+                    }
+                })
                 .enumerate()
                 .fold(
                     (0, 0.0),
@@ -307,4 +317,38 @@ pub fn compare(
         }
     }
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_particle(rho: f32) -> State {
+        State {
+            pos: vec![[0.0; 4]],
+            vel: vec![[0.0; 4]],
+            acc: vec![[0.0; 4]],
+            acc_b: vec![[0.0; 4]],
+            rho: vec![rho],
+            p: vec![0.0],
+            mass: vec![1.0],
+            phase: vec![0],
+            id: vec![0],
+            ..State::default()
+        }
+    }
+
+    /// A NaN on the device side is an infinite difference, never "identical".
+    #[test]
+    fn nan_on_one_side_is_an_infinite_difference() {
+        let scales = ToleranceScales {
+            pressure: 1.0,
+            acceleration: 1.0,
+        };
+        let d = largest_differences(&one_particle(1000.0), &one_particle(f32::NAN), &scales);
+        let rho = d.iter().find(|f| f.field == "density").unwrap();
+        assert_eq!(rho.relative, f64::INFINITY);
+        let same = largest_differences(&one_particle(1000.0), &one_particle(1000.0), &scales);
+        assert!(same.iter().all(|f| f.relative == 0.0));
+    }
 }

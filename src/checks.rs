@@ -82,6 +82,75 @@ pub struct Checker {
     front_info: String,
     /// (t, heat leaving through free surfaces) per sample (laser energy check).
     losses: Vec<(f64, f64)>,
+    /// Compression check: the worst sample so far and the running mean.
+    compression: Compression,
+}
+
+/// Liquid density relative to ρ0 over the samples of a run.
+struct Compression {
+    /// Largest (ρ − ρ0)/ρ0 seen, when, and which particle id.
+    max: f64,
+    t_max: f64,
+    id_max: u32,
+    /// Sum over samples of the mean (ρ − ρ0)/ρ0 of the liquid, and the sample count.
+    mean_sum: f64,
+    samples: usize,
+}
+
+impl Default for Compression {
+    fn default() -> Self {
+        Compression {
+            max: f64::NEG_INFINITY,
+            t_max: 0.0,
+            id_max: 0,
+            mean_sum: 0.0,
+            samples: 0,
+        }
+    }
+}
+
+impl Compression {
+    fn observe(&mut self, m: &Model, st: &State, t: f64) {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for i in 0..st.len() {
+            let phase = &m.phases[st.phase[i] as usize];
+            if phase.kind != PhaseKind::Liquid {
+                continue;
+            }
+            let e = (st.rho[i] as f64 - phase.rho0) / phase.rho0;
+            if e > self.max {
+                (self.max, self.t_max, self.id_max) = (e, t, st.id[i]);
+            }
+            sum += e;
+            n += 1;
+        }
+        if n > 0 {
+            self.mean_sum += sum / n as f64;
+            self.samples += 1;
+        }
+    }
+
+    fn verdict(&self) -> (String, f64, Vec<String>) {
+        if self.samples == 0 {
+            return (
+                "largest liquid compression".into(),
+                f64::NAN,
+                vec!["  no liquid".into()],
+            );
+        }
+        let details = vec![format!(
+            "  largest at t = {:.4e} s (particle id {}); mean (ρ − ρ0)/ρ0 over the liquid, averaged over {} samples: {:+.3e}",
+            self.t_max,
+            self.id_max,
+            self.samples,
+            self.mean_sum / self.samples as f64
+        )];
+        (
+            "largest liquid compression (ρ − ρ0)/ρ0".into(),
+            self.max,
+            details,
+        )
+    }
 }
 
 impl Checker {
@@ -95,6 +164,7 @@ impl Checker {
             fronts: Vec::new(),
             front_info: String::new(),
             losses: Vec::new(),
+            compression: Compression::default(),
         })
     }
 
@@ -108,6 +178,7 @@ impl Checker {
                     .fold(f64::MIN, f64::max);
                 self.samples.push((t, front + 0.5 * m.dx));
             }
+            CheckKind::Compression => self.compression.observe(m, st, t),
             CheckKind::TwoLayer => {
                 let (top_liq, bottom_gas) = layer_extent(m, st);
                 self.max_penetration = self.max_penetration.max(top_liq - bottom_gas);
@@ -161,6 +232,7 @@ impl Checker {
             }
             CheckKind::Stefan1d => heat_checks::stefan_1d(m, &self.fronts, &self.front_info),
             CheckKind::Rosenthal => heat_checks::rosenthal(m, st),
+            CheckKind::Compression => self.compression.verdict(),
             CheckKind::LaserEnergy => heat_checks::laser_energy(
                 m,
                 st,

@@ -421,6 +421,9 @@ pub enum CheckKind {
     LaserEnergy,
     /// Quasi-steady temperature around a moving source on a plate (Rosenthal).
     Rosenthal,
+    /// Weak compressibility: the largest (ρ − ρ0)/ρ0 of any liquid particle at any
+    /// sample, the cost side of a WCSPH sound speed (c ≥ 10 u_max aims at about 1%).
+    Compression,
 }
 
 impl CheckKind {
@@ -438,6 +441,7 @@ impl CheckKind {
             CheckKind::Stefan1d => "stefan_1d",
             CheckKind::LaserEnergy => "laser_energy",
             CheckKind::Rosenthal => "rosenthal",
+            CheckKind::Compression => "compression",
         }
     }
 }

@@ -246,3 +246,37 @@ fn gpu_run_with_profile_reports_passes() {
         "{stdout}"
     );
 }
+
+/// The compression check on a column started at rest in equilibrium: the deepest
+/// particle (centre Δx/2 above the floor, 0.395 m under the surface) carries
+/// ρ/ρ0 − 1 = g d / c² = 9.81 · 0.395 / 30² = 4.305e-3 (linear EOS, p = ρ0 g d).
+/// Tolerance 5%: the start-up acoustic overshoot of the 0.3 s run, measured at +2.9%.
+#[test]
+fn compression_check_matches_hydrostatic_column() {
+    let c = run_check(
+        "hydrostatic_2d",
+        &[
+            "check.kind=compression",
+            "simulation.initial_pressure=hydrostatic",
+            "run.end_time=0.3",
+        ],
+    );
+    let exact = 9.81 * 0.395 / (30.0 * 30.0);
+    let err = (c.value - exact).abs() / exact;
+    assert!(err < 0.05, "compression {} vs g d / c² = {exact}", c.value);
+    assert!(c.pass, "{}", c.line());
+}
+
+/// The pySPlisHSPlasH comparison scene (README, Performance) must keep the peer's
+/// particle count, 47³ water particles, and pass `validate`.
+#[test]
+fn peer_bench_scene_has_the_peer_particle_count() {
+    let path = format!(
+        "{}/scenarios/bench/dam_break_splishsplash.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let o = common::spatter(&["validate", &path]);
+    let (out, err) = common::text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.contains("water (Liquid): 103823"), "{out}");
+}

@@ -92,9 +92,11 @@ struct Compression {
     max: f64,
     t_max: f64,
     id_max: u32,
-    /// Sum over samples of the mean (ρ − ρ0)/ρ0 of the liquid, and the sample count.
+    /// Sum over samples of the mean (ρ − ρ0)/ρ0 of the liquid, the sample count and
+    /// the last sample's time (`finish` observes the final state again).
     mean_sum: f64,
     samples: usize,
+    last_t: f64,
 }
 
 impl Default for Compression {
@@ -105,12 +107,17 @@ impl Default for Compression {
             id_max: 0,
             mean_sum: 0.0,
             samples: 0,
+            last_t: f64::NEG_INFINITY,
         }
     }
 }
 
 impl Compression {
     fn observe(&mut self, m: &Model, st: &State, t: f64) {
+        if t <= self.last_t {
+            return;
+        }
+        self.last_t = t;
         let (mut sum, mut n) = (0.0, 0usize);
         for i in 0..st.len() {
             let phase = &m.phases[st.phase[i] as usize];

@@ -2,7 +2,7 @@
 //! neighbours (F22 §3.3, exact mass, multiphase-safe) and the EOS p = c²(ρ − ρ0)
 //! (F22 (3)), clamped at p ≥ 0 when the scene asks for a pressure floor.
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::neighbors::{with_neighbor_r2, CellTable};
 use crate::kernel;
 use crate::params::{Params, FLAG_PRESSURE_FLOOR};
 use crate::state::State;
@@ -19,10 +19,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             if pr.is_wall(ph) {
                 return;
             }
-            let mut sum = 0.0f32;
-            for_each_neighbor(pr, pos, grid, i, |_, _, r2| {
-                sum += kernel::w(pr, r2.sqrt());
-            });
+            let sum = with_neighbor_r2(pr, pos, grid, i, |r2| kernel::sum_w(pr, r2));
             let r = mass[i] * sum;
             *rho = r;
             *p = equation_of_state(pr, ph, r);

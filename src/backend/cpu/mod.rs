@@ -110,6 +110,7 @@ impl Backend for CpuBackend {
             "load_state: particle count changed"
         );
         self.st = st.clone();
+        self.grid.invalidate();
     }
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
         std::mem::take(&mut self.times)

@@ -2,28 +2,42 @@
 //! neighbours (F22 §3.3, exact mass, multiphase-safe) and the EOS p = c²(ρ − ρ0)
 //! (F22 (3)), clamped at p ≥ 0 when the scene asks for a pressure floor.
 
-use super::neighbors::{with_neighbor_r2, CellTable};
+use super::neighbors::{with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK};
 use crate::kernel;
 use crate::params::{Params, FLAG_PRESSURE_FLOOR};
 use crate::state::State;
 use rayon::prelude::*;
 
-pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
+/// Also records each fluid particle's neighbours in `list` for the forces pass.
+pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
-    st.rho
-        .par_iter_mut()
-        .zip(st.p.par_iter_mut())
+    let chunks = list.take_chunks(st.len().div_ceil(LIST_CHUNK));
+    let chunks: Vec<ListChunk> = st
+        .rho
+        .par_chunks_mut(LIST_CHUNK)
+        .zip(st.p.par_chunks_mut(LIST_CHUNK))
+        .zip(chunks)
         .enumerate()
-        .for_each(|(i, (rho, p))| {
-            let ph = phase[i];
-            if pr.is_wall(ph) {
-                return;
+        .map(|(c, ((rho, p), mut chunk))| {
+            for k in 0..rho.len() {
+                let i = c * LIST_CHUNK + k;
+                let ph = phase[i];
+                if pr.is_wall(ph) {
+                    chunk.push(&[]);
+                    continue;
+                }
+                let sum = with_neighbors(pr, pos, grid, i, |js, r2| {
+                    chunk.push(js);
+                    kernel::sum_w(pr, r2)
+                });
+                let r = mass[i] * sum;
+                rho[k] = r;
+                p[k] = equation_of_state(pr, ph, r);
             }
-            let sum = with_neighbor_r2(pr, pos, grid, i, |r2| kernel::sum_w(pr, r2));
-            let r = mass[i] * sum;
-            *rho = r;
-            *p = equation_of_state(pr, ph, r);
-        });
+            chunk
+        })
+        .collect();
+    list.store(grid, chunks);
 }
 
 #[inline(always)]

@@ -19,13 +19,13 @@
 //! (h δ exceeds 1 only at wall–liquid–gas corners: 1.05 measured in two_layer_2d).
 //! Its dissipation is not added to the viscous heating.
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::neighbors::{for_each_listed, CellTable, NeighborList};
 use crate::kernel;
 use crate::params::{Params, FLAG_VISCOUS_HEATING};
 use crate::state::State;
 use rayon::prelude::*;
 
-pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     let (pos, vel, rho, p, mass, phase) = (&st.pos, &st.vel, &st.rho, &st.p, &st.mass, &st.phase);
     let surface = &st.surface;
     st.acc
@@ -52,7 +52,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             } else {
                 0.0
             };
-            for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
+            for_each_listed(pr, pos, grid, list, i, |j, d, r2| {
                 if r2 <= 0.0 {
                     return;
                 }

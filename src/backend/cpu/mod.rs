@@ -22,6 +22,8 @@ pub struct CpuBackend {
     pub st: State,
     pipeline: Pipeline,
     grid: neighbors::CellTable,
+    /// This step's fluid neighbours, from the density pass (for forces).
+    list: neighbors::NeighborList,
     /// Laser bins: (Σ wV, absorbed power), laser scenes only.
     laser_bins: Vec<[f32; 2]>,
     times: Vec<(&'static str, f64)>,
@@ -35,6 +37,7 @@ impl CpuBackend {
             pipeline,
             st,
             grid: neighbors::CellTable::default(),
+            list: neighbors::NeighborList::default(),
             laser_bins: Vec::new(),
             times: Vec::new(),
         }
@@ -75,9 +78,9 @@ impl Backend for CpuBackend {
         match stage {
             Stage::KickDrift => integrate::kick_drift(pr, &mut self.st),
             Stage::Neighbors => neighbors::run(pr, &mut self.st, &mut self.grid),
-            Stage::Density => density::run(pr, &mut self.st, &self.grid),
+            Stage::Density => density::run(pr, &mut self.st, &self.grid, &mut self.list),
             Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
-            Stage::Forces => forces::run(pr, &mut self.st, &self.grid),
+            Stage::Forces => forces::run(pr, &mut self.st, &self.grid, &self.list),
             Stage::Interface => interface::run(pr, &mut self.st, &self.grid),
             Stage::Laser if pr.laser[3] == LASER_SURFACE => laser::surface(pr, &mut self.st),
             Stage::Laser => {

@@ -116,21 +116,124 @@ pub fn for_each_neighbor(
     });
 }
 
-/// `f` gets r_ij² of every neighbour j of particle i (r_ij² < support²), in
-/// `for_each_neighbor`'s order, as one slice.
+/// `f` gets the index j and r_ij² of every neighbour j of particle i
+/// (r_ij² < support²), in `for_each_neighbor`'s order, as two slices.
 #[inline(always)]
-pub fn with_neighbor_r2<R>(
+pub fn with_neighbors<R>(
     pr: &Params,
     pos: &[[f32; 4]],
     grid: &CellTable,
     i: usize,
-    f: impl FnOnce(&[f32]) -> R,
+    f: impl FnOnce(&[u32], &[f32]) -> R,
 ) -> R {
     NEAR.with(|near| {
         let near = &mut *near.borrow_mut();
         near.sweep(pr, pos, grid, pos[i]);
-        f(&near.hit_r2[..near.count])
+        let count = near.count;
+        for k in 0..count {
+            near.hit_j[k] = near.j[near.hits[k] as usize];
+        }
+        f(&near.hit_j[..count], &near.hit_r2[..count])
     })
+}
+
+/// Particles per chunk of the neighbour list (one parallel task each).
+pub const LIST_CHUNK: usize = 1024;
+
+/// Most neighbour indices the list holds (512 MiB); a step that would need more
+/// records none, and its later passes sweep the cells themselves.
+const LIST_MAX_ENTRIES: usize = 1 << 27;
+
+/// The neighbours of every fluid particle, recorded by the density pass in the
+/// walk's order, so that the forces pass of the same step reads them instead of
+/// sweeping the cells again. Valid for one cell table (`CellTable::generation`).
+#[derive(Default)]
+pub struct NeighborList {
+    generation: u64,
+    chunks: Vec<ListChunk>,
+}
+
+/// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK: those of the
+/// k-th are j[offsets[k]..offsets[k + 1]] (none for a wall particle).
+#[derive(Default)]
+pub struct ListChunk {
+    offsets: Vec<u32>,
+    j: Vec<u32>,
+}
+
+impl ListChunk {
+    fn clear(&mut self) {
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.j.clear();
+    }
+    /// Ends the current particle with neighbours `js` (empty for one not gathered).
+    pub fn push(&mut self, js: &[u32]) {
+        self.j.extend_from_slice(js);
+        self.offsets.push(self.j.len() as u32);
+    }
+}
+
+impl NeighborList {
+    /// `n` empty chunks for the density pass to fill, reusing the buffers of the
+    /// last step's list (no allocation once the sizes have settled).
+    pub fn take_chunks(&mut self, n: usize) -> Vec<ListChunk> {
+        let mut chunks = std::mem::take(&mut self.chunks);
+        self.generation = 0;
+        chunks.resize_with(n, ListChunk::default);
+        for c in &mut chunks {
+            c.clear();
+        }
+        chunks
+    }
+
+    /// Keeps the chunks of this step's density pass for `grid`, unless they hold
+    /// more than LIST_MAX_ENTRIES indices.
+    pub fn store(&mut self, grid: &CellTable, chunks: Vec<ListChunk>) {
+        let entries: usize = chunks.iter().map(|c| c.j.len()).sum();
+        if entries <= LIST_MAX_ENTRIES {
+            self.generation = grid.generation;
+            self.chunks = chunks;
+        } else {
+            self.generation = 0;
+            self.chunks = Vec::new();
+        }
+    }
+
+    fn of(&self, grid: &CellTable, i: usize) -> Option<&[u32]> {
+        if self.generation == 0 || self.generation != grid.generation {
+            return None;
+        }
+        let c = &self.chunks[i / LIST_CHUNK];
+        let k = i % LIST_CHUNK;
+        Some(&c.j[c.offsets[k] as usize..c.offsets[k + 1] as usize])
+    }
+}
+
+/// `for_each_neighbor` for a fluid particle, read from the step's neighbour list
+/// when it has one for this cell table: the same j in the same order, with d and
+/// r² recomputed by `min_image` and the same sum, so the same bits.
+#[inline(always)]
+pub fn for_each_listed(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    list: &NeighborList,
+    i: usize,
+    mut f: impl FnMut(usize, [f32; 3], f32),
+) {
+    match list.of(grid, i) {
+        Some(js) => {
+            let pi = pos[i];
+            for &j in js {
+                let j = j as usize;
+                let d = min_image(pr, pi, pos[j]);
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                f(j, d, r2);
+            }
+        }
+        None => for_each_neighbor(pr, pos, grid, i, f),
+    }
 }
 
 thread_local! {
@@ -154,6 +257,7 @@ struct Candidates {
     /// Indices into the candidate arrays of those inside the support, in order,
     /// and their r².
     hits: Vec<u32>,
+    hit_j: Vec<u32>,
     hit_r2: Vec<f32>,
     count: usize,
 }
@@ -183,6 +287,7 @@ impl Candidates {
             v.resize(n, 0.0);
         }
         self.hits.resize(n, 0);
+        self.hit_j.resize(n, 0);
         self.hit_r2.resize(n, 0.0);
     }
 
@@ -328,4 +433,75 @@ fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[usize]) {
     let src = &*v;
     let out: Vec<T> = perm.par_iter().map(|&s| src[s]).collect();
     *v = out;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type Visit = (usize, [u32; 3], u32);
+
+    fn bits(j: usize, d: [f32; 3], r2: f32) -> Visit {
+        (j, d.map(f32::to_bits), r2.to_bits())
+    }
+
+    /// A scene with jittered particles (irregular distances), sorted into cells.
+    fn jittered(scene: &str) -> (Params, State, CellTable) {
+        let path = format!(
+            "{}/scenarios/validation/{scene}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let l = crate::run::load(&path, &["jitter=0.3".into()]).unwrap();
+        let pr = Params::new(&l.model, 2);
+        let mut st = l.state.clone();
+        let mut grid = CellTable::default();
+        run(&pr, &mut st, &mut grid);
+        (pr, st, grid)
+    }
+
+    /// The cached sweep (`for_each_neighbor`), the recorded list
+    /// (`for_each_listed`) and the list's fallback after `invalidate` visit exactly
+    /// the pairs of the plain cell walk (`for_each_near`), in its order, with the
+    /// same bits of d and r²: periodic 2D and walled 3D.
+    #[test]
+    fn sweep_and_list_match_the_plain_walk() {
+        for scene in ["poiseuille_2d", "dam_break_3d"] {
+            let (pr, mut st, mut grid) = jittered(scene);
+            let mut list = NeighborList::default();
+            super::super::density::run(&pr, &mut st, &grid, &mut list);
+            let pos = &st.pos;
+            let mut pairs = 0;
+            for i in 0..pos.len() {
+                let mut walk: Vec<Visit> = Vec::new();
+                for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
+                    walk.push(bits(j, d, r2))
+                });
+                let mut swept: Vec<Visit> = Vec::new();
+                for_each_neighbor(&pr, pos, &grid, i, |j, d, r2| swept.push(bits(j, d, r2)));
+                assert_eq!(walk, swept, "{scene}: sweep of particle {i}");
+                if !pr.is_wall(st.phase[i]) {
+                    let mut listed: Vec<Visit> = Vec::new();
+                    for_each_listed(&pr, pos, &grid, &list, i, |j, d, r2| {
+                        listed.push(bits(j, d, r2))
+                    });
+                    assert_eq!(walk, listed, "{scene}: list of particle {i}");
+                    assert!(list.of(&grid, i).is_some());
+                }
+                pairs += walk.len();
+            }
+            assert!(pairs > 10 * pos.len(), "{scene}: {pairs} pairs");
+            grid.invalidate();
+            let i = (0..pos.len()).find(|&i| !pr.is_wall(st.phase[i])).unwrap();
+            assert!(list.of(&grid, i).is_none(), "stale list used");
+            let mut walk: Vec<Visit> = Vec::new();
+            for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
+                walk.push(bits(j, d, r2))
+            });
+            let mut listed: Vec<Visit> = Vec::new();
+            for_each_listed(&pr, pos, &grid, &list, i, |j, d, r2| {
+                listed.push(bits(j, d, r2))
+            });
+            assert_eq!(walk, listed, "{scene}: fallback sweep");
+        }
+    }
 }

@@ -118,7 +118,8 @@ fn two_layer_ratio_1000_with_interface_viscosity_within_5_percent() {
 /// 19.1% at T = 1.19 (the front is one particle, so rounding moves it by about a
 /// point: 19.3% before the wall pass's weight floor, 19.9% on an H100). Refining
 /// dx 5 → 2.5 → 1.25 mm gave 18.7 → 19.3 → 20.9%, so it is not discretisation
-/// error (note on issue 2). Kept at the issue's 10%
+/// error (note on issue 2). DualSPHysics' own validation case runs as far ahead
+/// of the same experiment (README, Validation). Kept at the issue's 10%
 /// tolerance rather than widened; run with `--ignored` to see it.
 #[test]
 #[ignore = "surge front 20.4% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]

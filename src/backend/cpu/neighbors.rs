@@ -309,13 +309,7 @@ impl Candidates {
             if pr.grid[3] & (1 << a) != 0 {
                 let (half, period) = (pr.half_period[a], pr.period[a]);
                 for d in d.iter_mut() {
-                    *d = if *d > half {
-                        *d - period
-                    } else if *d < -half {
-                        *d + period
-                    } else {
-                        *d
-                    };
+                    *d = wrap_axis(*d, half, period);
                 }
             }
         }
@@ -365,14 +359,23 @@ pub fn min_image(pr: &Params, a: [f32; 4], b: [f32; 4]) -> [f32; 3] {
     let mut d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     for k in 0..3 {
         if pr.grid[3] & (1 << k) != 0 {
-            if d[k] > pr.half_period[k] {
-                d[k] -= pr.period[k];
-            } else if d[k] < -pr.half_period[k] {
-                d[k] += pr.period[k];
-            }
+            d[k] = wrap_axis(d[k], pr.half_period[k], pr.period[k]);
         }
     }
     d
+}
+
+/// One component of a difference brought into (−period/2, period/2]: the minimum
+/// image on a periodic axis (a select, so a sweep of it vectorises).
+#[inline(always)]
+fn wrap_axis(d: f32, half: f32, period: f32) -> f32 {
+    if d > half {
+        d - period
+    } else if d < -half {
+        d + period
+    } else {
+        d
+    }
 }
 
 #[inline(always)]

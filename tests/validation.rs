@@ -94,9 +94,12 @@ fn hydrostatic_start_stacks_the_layers() {
 /// Density ratio 1000, issue 2's upper bound, without the interface viscosity:
 /// two_layer_2d with an air-like gas (ρ = 1 kg/m³, c = 316 m/s at the same p0).
 /// With the hydrostatic start no particle crosses the interface: the lowest
-/// own-phase colour is 0.647 (a gas particle at the wall–liquid–gas corner; the
-/// threshold is ½), while the liquid's top ends 0.21 Δx above the gas's bottom at
-/// the other side of the box, a meniscus rather than a crossing. The pressure
+/// own-phase colour is 0.669 (threshold ½). The interface need not stay level
+/// for that: an f32 rounding change in the forces pass (∂W/∂r / r computed once
+/// per pair) ended the run with the liquid's top at the left wall 0.21 Δx above
+/// the gas's bottom 2 Δx away, a meniscus with every particle on its own side
+/// (lowest colour 0.647), which a global top-versus-bottom test calls a crossing
+/// (measured, not kept: the rounding change gained nothing). The pressure
 /// jump is printed, not asserted: undamped, the light gas rings and the
 /// instantaneous jump at t = 0.1 s swings between 2% and 21% of the liquid head.
 /// two_layer_ratio1000_2d adds F22's interface viscosity and meets 5%.
@@ -112,8 +115,8 @@ fn two_layer_ratio_1000_no_crossing() {
 
 /// The crossing criterion catches a real crossing: the same ratio-1000 scene
 /// started at p = 0 instead of hydrostatic sinks, and its settling transient
-/// carries liquid 4.5 Δx up into the gas (measured: 10 particles with own-phase
-/// colour below ½ at once, the lowest 0.33), so the check must fail on it.
+/// carries liquid 4.8 Δx up into the gas (measured: 13 particles with own-phase
+/// colour below ½ at once, the lowest 0.31), so the check must fail on it.
 #[test]
 fn two_layer_check_fails_when_liquid_enters_the_gas() {
     let c = run_check(

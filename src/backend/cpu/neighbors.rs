@@ -102,8 +102,7 @@ pub fn for_each_neighbor(
     i: usize,
     mut f: impl FnMut(usize, [f32; 3], f32),
 ) {
-    NEAR.with(|near| {
-        let near = &mut *near.borrow_mut();
+    with_candidates(|near| {
         near.sweep(pr, pos, grid, pos[i]);
         for k in 0..near.count {
             let c = near.hits[k] as usize;
@@ -126,8 +125,7 @@ pub fn with_neighbors<R>(
     i: usize,
     f: impl FnOnce(&[u32], &[f32]) -> R,
 ) -> R {
-    NEAR.with(|near| {
-        let near = &mut *near.borrow_mut();
+    with_candidates(|near| {
         near.sweep(pr, pos, grid, pos[i]);
         let count = near.count;
         for k in 0..count {
@@ -238,6 +236,17 @@ pub fn for_each_listed(
 
 thread_local! {
     static NEAR: RefCell<Candidates> = RefCell::new(Candidates::default());
+}
+
+/// Runs `f` on this thread's candidate cache, or on a fresh one when a caller up
+/// the stack holds it (a neighbour callback that walks neighbours itself): the
+/// same neighbours either way, the nested walk only slower.
+#[inline(always)]
+fn with_candidates<R>(f: impl FnOnce(&mut Candidates) -> R) -> R {
+    NEAR.with(|near| match near.try_borrow_mut() {
+        Ok(mut near) => f(&mut near),
+        Err(_) => f(&mut Candidates::default()),
+    })
 }
 
 /// The particles of one cell's neighbourhood in walk order (structure of arrays),
@@ -506,5 +515,34 @@ mod tests {
             });
             assert_eq!(walk, listed, "{scene}: fallback sweep");
         }
+    }
+
+    /// A walk from inside a neighbour callback (the thread's candidate cache is
+    /// held) sees the same neighbours as a plain walk, and leaves the outer walk's
+    /// cache intact.
+    #[test]
+    fn nested_walks_match_the_plain_walk() {
+        let (pr, st, grid) = jittered("dam_break_3d");
+        let pos = &st.pos;
+        let i = pos.len() / 2;
+        let mut outer: Vec<Visit> = Vec::new();
+        let mut nested = 0;
+        for_each_neighbor(&pr, pos, &grid, i, |j, d, r2| {
+            outer.push(bits(j, d, r2));
+            let mut walk: Vec<Visit> = Vec::new();
+            for_each_near(&pr, pos, &grid, pos[j], |k, d, r2| {
+                walk.push(bits(k, d, r2))
+            });
+            let mut inner: Vec<Visit> = Vec::new();
+            for_each_neighbor(&pr, pos, &grid, j, |k, d, r2| inner.push(bits(k, d, r2)));
+            assert_eq!(walk, inner, "nested walk from particle {j}");
+            nested += 1;
+        });
+        let mut walk: Vec<Visit> = Vec::new();
+        for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
+            walk.push(bits(j, d, r2))
+        });
+        assert_eq!(walk, outer, "outer walk of particle {i}");
+        assert!(nested > 10, "{nested} neighbours");
     }
 }

@@ -4,6 +4,7 @@
 use crate::model::Model;
 use crate::scene::{CheckKind, DamBreakExperiment, PhaseKind};
 use crate::state::State;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 #[path = "heat_checks.rs"]
@@ -400,16 +401,22 @@ fn crossing(m: &Model, st: &State) -> Crossing {
         t: st.sim.time as f64,
         x: [0.0; 3],
     };
-    for i in (0..st.len()).filter(|&i| fluid(i)) {
-        let (mut own, mut all) = (0.0, 0.0);
-        grid.for_each_near(m, st, i, |j, r| {
-            let vw = (st.mass[j] / st.rho[j]) as f64 * crate::kernel::w(&pr, r as f32) as f64;
-            all += vw;
-            if kind_of(m, st, j) == kind_of(m, st, i) {
-                own += vw;
-            }
-        });
-        let c = own / all;
+    let colours: Vec<(usize, f64)> = (0..st.len())
+        .into_par_iter()
+        .filter(|&i| fluid(i))
+        .map(|i| {
+            let (mut own, mut all) = (0.0, 0.0);
+            grid.for_each_near(m, st, i, |j, r| {
+                let vw = (st.mass[j] / st.rho[j]) as f64 * crate::kernel::w(&pr, r as f32) as f64;
+                all += vw;
+                if kind_of(m, st, j) == kind_of(m, st, i) {
+                    own += vw;
+                }
+            });
+            (i, own / all)
+        })
+        .collect();
+    for (i, c) in colours {
         if c < 0.5 {
             worst.count += 1;
         }

@@ -385,9 +385,9 @@ struct Crossing {
 /// The interface is where the colour function is ½ (the F22 (19) normal is its
 /// gradient), so c_i < ½ means particle i sits on the other phase's side. This
 /// asks what issue 2 asks, whether a particle crossed, and not whether the
-/// interface stays flat: a meniscus at a wall lifts the liquid's top above the
-/// gas's bottom at the other end of the box, yet every particle stays on its own
-/// side (see two_layer's details). Walls do not count, so a corner particle's
+/// interface stays flat: a meniscus at a wall can lift the liquid's top above
+/// the gas's bottom a few particles away, yet every particle stays on its own
+/// side (tests/validation.rs, two_layer_ratio_1000_no_crossing). Walls do not count, so a corner particle's
 /// share is of the fluid it touches.
 fn crossing(m: &Model, st: &State) -> Crossing {
     let pr = crate::params::Params::new(m, st.len() as u32);

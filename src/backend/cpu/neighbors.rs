@@ -476,6 +476,13 @@ mod tests {
         (j, d.map(f32::to_bits), r2.to_bits())
     }
 
+    /// The pairs a walk reports, in its order, as bits.
+    fn visits(walk: impl FnOnce(&mut dyn FnMut(usize, [f32; 3], f32))) -> Vec<Visit> {
+        let mut seen = Vec::new();
+        walk(&mut |j, d, r2| seen.push(bits(j, d, r2)));
+        seen
+    }
+
     /// A scene with jittered particles (irregular distances), sorted into cells.
     fn jittered(scene: &str) -> (Params, State, CellTable) {
         let path = format!(
@@ -503,18 +510,11 @@ mod tests {
             let pos = &st.pos;
             let mut pairs = 0;
             for i in 0..pos.len() {
-                let mut walk: Vec<Visit> = Vec::new();
-                for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
-                    walk.push(bits(j, d, r2))
-                });
-                let mut swept: Vec<Visit> = Vec::new();
-                for_each_neighbor(&pr, pos, &grid, i, |j, d, r2| swept.push(bits(j, d, r2)));
+                let walk = visits(|f| for_each_near(&pr, pos, &grid, pos[i], f));
+                let swept = visits(|f| for_each_neighbor(&pr, pos, &grid, i, f));
                 assert_eq!(walk, swept, "{scene}: sweep of particle {i}");
                 if !pr.is_wall(st.phase[i]) {
-                    let mut listed: Vec<Visit> = Vec::new();
-                    for_each_listed(&pr, pos, &grid, &list, i, |j, d, r2| {
-                        listed.push(bits(j, d, r2))
-                    });
+                    let listed = visits(|f| for_each_listed(&pr, pos, &grid, &list, i, f));
                     assert_eq!(walk, listed, "{scene}: list of particle {i}");
                     assert!(list.of(&grid, i).is_some());
                 }
@@ -524,14 +524,8 @@ mod tests {
             grid.invalidate();
             let i = (0..pos.len()).find(|&i| !pr.is_wall(st.phase[i])).unwrap();
             assert!(list.of(&grid, i).is_none(), "stale list used");
-            let mut walk: Vec<Visit> = Vec::new();
-            for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
-                walk.push(bits(j, d, r2))
-            });
-            let mut listed: Vec<Visit> = Vec::new();
-            for_each_listed(&pr, pos, &grid, &list, i, |j, d, r2| {
-                listed.push(bits(j, d, r2))
-            });
+            let walk = visits(|f| for_each_near(&pr, pos, &grid, pos[i], f));
+            let listed = visits(|f| for_each_listed(&pr, pos, &grid, &list, i, f));
             assert_eq!(walk, listed, "{scene}: fallback sweep");
         }
     }
@@ -548,19 +542,12 @@ mod tests {
         let mut nested = 0;
         for_each_neighbor(&pr, pos, &grid, i, |j, d, r2| {
             outer.push(bits(j, d, r2));
-            let mut walk: Vec<Visit> = Vec::new();
-            for_each_near(&pr, pos, &grid, pos[j], |k, d, r2| {
-                walk.push(bits(k, d, r2))
-            });
-            let mut inner: Vec<Visit> = Vec::new();
-            for_each_neighbor(&pr, pos, &grid, j, |k, d, r2| inner.push(bits(k, d, r2)));
+            let walk = visits(|f| for_each_near(&pr, pos, &grid, pos[j], f));
+            let inner = visits(|f| for_each_neighbor(&pr, pos, &grid, j, f));
             assert_eq!(walk, inner, "nested walk from particle {j}");
             nested += 1;
         });
-        let mut walk: Vec<Visit> = Vec::new();
-        for_each_near(&pr, pos, &grid, pos[i], |j, d, r2| {
-            walk.push(bits(j, d, r2))
-        });
+        let walk = visits(|f| for_each_near(&pr, pos, &grid, pos[i], f));
         assert_eq!(walk, outer, "outer walk of particle {i}");
         assert!(nested > 10, "{nested} neighbours");
     }

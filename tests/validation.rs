@@ -144,12 +144,56 @@ fn two_layer_ratio_1000_with_interface_viscosity_within_5_percent() {
 /// point: 19.3% before the wall pass's weight floor, 19.9% on an H100). Refining
 /// dx 5 → 2.5 → 1.25 mm gave 18.7 → 19.3 → 20.9%, so it is not discretisation
 /// error (note on issue 2). DualSPHysics' own validation case runs as far ahead
-/// of the same experiment (README, Validation). Kept at the issue's 10%
-/// tolerance rather than widened; run with `--ignored` to see it.
+/// of the same experiment (README, Validation), and with one fitted release
+/// delay the front is within 10% of both experiments (the tests below). Kept at
+/// the issue's 10% tolerance rather than widened; run with `--ignored` to see it.
 #[test]
 #[ignore = "surge front 20.4% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
 fn dam_break_front_within_10_percent() {
     check_passes("dam_break_2d");
+}
+
+/// The front's motion once it has started, against both experiments. The run
+/// releases the column at t = 0; in the experiments a gate (Koshizuka & Oka) or a
+/// diaphragm (Martin & Moyce) had to clear first, and neither paper reports how
+/// long that took. So the experiment's clock gets one fitted start delay ΔT in
+/// (0, 0.5) of T (up to 43 / 27 ms in their columns), and the front must then be
+/// within the issue's 10% of every data point with T <= 2.5. A front at the wrong
+/// speed fails whatever the delay (unit test in checks.rs); the unshifted criterion
+/// stays in the ignored test above. Measured on the CPU (2D, dx = 2.5 mm): K&O
+/// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
+/// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse): 7.5% at
+/// ΔT = 0.152, 2.4% at ΔT = 0.185.
+fn front_matches_after_release_delay(scene: &str) {
+    let c = run_check(scene, &[]);
+    let figure = |key: String| {
+        c.figures
+            .iter()
+            .find(|f| f.0 == key)
+            .map(|f| f.1)
+            .unwrap_or_else(|| panic!("no figure {key}"))
+    };
+    for exp in ["koshizuka_oka", "martin_moyce"] {
+        let delay = figure(format!("release_delay_{exp}"));
+        let error = figure(format!("release_delay_error_{exp}"));
+        // A best fit inside the window, not at its edge: the run leads the data.
+        assert!(delay > 0.0 && delay < 0.5, "{exp}: delay {delay}");
+        assert!(
+            error <= 0.10,
+            "{exp}: {:.1}% at delay {delay}",
+            100.0 * error
+        );
+    }
+}
+
+#[test]
+fn dam_break_2d_front_moves_as_in_the_experiments_after_the_release() {
+    front_matches_after_release_delay("dam_break_2d");
+}
+
+#[test]
+fn dam_break_3d_front_moves_as_in_the_experiments_after_the_release() {
+    front_matches_after_release_delay("dam_break_3d");
 }
 
 #[test]

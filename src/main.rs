@@ -403,9 +403,21 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     );
     let l = &m.limits;
     let (lim, which) = l.min();
+    // A limit whose physics the scene lacks (no heat, no viscosity, no body force)
+    // is infinite: say so instead of printing "inf s".
+    let limit = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.4e} s")
+        } else {
+            "none (not in this scene)".to_string()
+        }
+    };
     println!(
-        "time-step limits: acoustic {:.4e} s, viscous {:.4e} s, body force {:.4e} s, conduction {:.4e} s; binding: {which}",
-        l.acoustic, l.viscous, l.body_force, l.conduction
+        "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}; binding: {which}",
+        limit(l.acoustic),
+        limit(l.viscous),
+        limit(l.body_force),
+        limit(l.conduction)
     );
     match m.fixed_dt {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),

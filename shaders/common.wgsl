@@ -28,7 +28,7 @@ struct Params {
     laser_path: array<vec4<f32>, 8>,  // time, lateral beam centre
     laser_power: array<vec4<f32>, 8>, // time, power from then on
     consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
-    wall: vec4<f32>,              // wall pass: Shepard weight floor
+    wall: vec4<f32>,              // wall pass: Shepard weight floor; moving wall phases (bit mask)
 }
 
 struct Sim {
@@ -94,6 +94,11 @@ fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 // Wall or solid: does not move, is a wall for the fluid passes.
 fn is_wall(ph: u32) -> bool {
     return P.phase_a[ph].w >= KIND_WALL;
+}
+
+// A wall phase whose particles move with its velocity (phase_b.xyz).
+fn wall_moves(ph: u32) -> bool {
+    return ((u32(P.wall.y) >> ph) & 1u) != 0u;
 }
 
 // Carries an evolving temperature: liquid, gas or solid in a heat scene.

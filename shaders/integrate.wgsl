@@ -4,8 +4,20 @@
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i >= P.counts.x) { return; }
-    if (is_wall(phase[i])) { return; }
+    let ph = phase[i];
     let dt = sim.dt;
+    if (is_wall(ph)) {
+        // A moving wall drifts with its prescribed velocity; others stay.
+        if (wall_moves(ph)) {
+            let w = P.phase_b[ph];
+            var xw = pos[i];
+            for (var c = 0u; c < 3u; c++) {
+                xw[c] = wrap_periodic(xw[c] + dt * w[c], c);
+            }
+            pos[i] = xw;
+        }
+        return;
+    }
     let hdt = c_half() * dt;
     let a = acc[i];
     let ab = acc_b[i];
@@ -13,17 +25,22 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     var x = pos[i];
     for (var c = 0u; c < 3u; c++) {
         v[c] = v[c] + hdt * a[c];
-        x[c] = x[c] + dt * (v[c] + hdt * ab[c]);
-        if ((P.grid.w & (1u << c)) != 0u) {
-            if (x[c] >= P.period[c]) {
-                x[c] = x[c] - P.period[c];
-            } else if (x[c] < 0.0) {
-                x[c] = x[c] + P.period[c];
-            }
-        }
+        x[c] = wrap_periodic(x[c] + dt * (v[c] + hdt * ab[c]), c);
     }
     vel[i] = v;
     pos[i] = x;
+}
+
+// Brings coordinate x of axis c back into [0, period) on a periodic axis.
+fn wrap_periodic(x: f32, c: u32) -> f32 {
+    if ((P.grid.w & (1u << c)) != 0u) {
+        if (x >= P.period[c]) {
+            return x - P.period[c];
+        } else if (x < 0.0) {
+            return x + P.period[c];
+        }
+    }
+    return x;
 }
 
 @compute @workgroup_size(64)

@@ -673,9 +673,9 @@ const DELAY_STEP: f64 = 0.0025;
 const DELAY_STEPS: usize = 200;
 
 /// The run against one experiment once the experiment's clock is allowed to start
-/// early: Z_run(T − ΔT) against Z_data(T). In the experiments a gate or diaphragm
-/// had to be removed before the column could fall, and neither paper gives how
-/// long that took, while the run releases the column at t = 0. A front that moves
+/// early: Z_run(T − ΔT) against Z_data(T). In the experiments whatever held the
+/// column had to be removed before it could fall, and the data carry no record of
+/// how long that took, while the run releases the column at t = 0. A front that moves
 /// as in the experiment but starts late is matched by one delay; a front that moves
 /// at the wrong speed is not matched by any.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -388,7 +388,13 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     println!("particles: {}", st.len());
     for (i, ph) in m.phases.iter().enumerate() {
         let n = st.phase.iter().filter(|&&p| p as usize == i).count();
-        println!("  {} ({:?}): {n}", ph.name, ph.kind);
+        let motion = if ph.moves {
+            let v = &ph.velocity[..m.dim as usize];
+            format!(", moving at {v:?} m/s")
+        } else {
+            String::new()
+        };
+        println!("  {} ({:?}{motion}): {n}", ph.name, ph.kind);
     }
     println!(
         "cell grid: {} x {} x {} = {} cells",

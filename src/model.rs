@@ -16,6 +16,8 @@ pub struct PhaseInfo {
     pub viscosity: f64,
     pub slip: Slip,
     pub velocity: [f64; 3],
+    /// A wall whose particles move with `velocity` (scene key `moves`).
+    pub moves: bool,
     /// Particle mass ρ0 Δx^d (F22 Remark 2).
     pub mass: f64,
     pub thermal: Option<Thermal>,
@@ -584,6 +586,9 @@ fn phase_table(
             }
             None => [0.0; 3],
         };
+        if p.moves && (p.kind != PhaseKind::Wall || p.velocity.is_none()) {
+            return Err(cx.err(&key("moves"), "only a wall phase with a velocity can move"));
+        }
         out.push(PhaseInfo {
             name: name.clone(),
             kind: p.kind,
@@ -593,6 +598,7 @@ fn phase_table(
             viscosity,
             slip: p.slip,
             velocity,
+            moves: p.moves,
             mass: rho0 * dx.powi(dim as i32),
             thermal: None,
             switch_to: None,

@@ -98,7 +98,8 @@ pub struct Params {
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
     /// shaders read every multiplying or adding literal from here.
     pub consts: [[f32; 4]; 8],
-    /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)), unused ×3.
+    /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)); bit i set
+    /// (as an exact integer) when wall phase i moves with its velocity; unused ×2.
     pub wall: [f32; 4],
 }
 
@@ -260,6 +261,14 @@ impl Params {
             p.interface[3] = m.interface_viscosity as f32;
         }
         p.wall[0] = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
+        let moving: u32 = m
+            .phases
+            .iter()
+            .enumerate()
+            .filter(|(_, ph)| ph.moves)
+            .map(|(i, _)| 1u32 << i)
+            .sum();
+        p.wall[1] = moving as f32;
         p
     }
     pub fn n(&self) -> usize {
@@ -268,6 +277,10 @@ impl Params {
     /// A wall for the fluid passes: wall or solid particles (they do not move).
     pub fn is_wall(&self, phase: u32) -> bool {
         self.phase_a[phase as usize][3] >= KIND_WALL
+    }
+    /// A wall phase whose particles move with its velocity (`phase_b`).
+    pub fn wall_moves(&self, phase: u32) -> bool {
+        (self.wall[1] as u32 >> phase) & 1 != 0
     }
     /// Carries an evolving temperature (liquid, gas or solid in a heat scene).
     pub fn conducts(&self, phase: u32) -> bool {

@@ -279,8 +279,14 @@ pub struct PhaseDef {
     pub material: String,
     #[serde(default)]
     pub slip: Slip,
-    /// Prescribed velocity of a wall phase (m/s); walls do not move in position.
+    /// Prescribed velocity of a wall phase (m/s). It enters the no-slip condition;
+    /// the wall's particles stay in place unless `moves` is set.
     pub velocity: Option<Vec<f64>>,
+    /// Wall phases: the particles move with `velocity` from t = 0 (a gate lifted
+    /// out of the tank, a sliding plate). Without it the wall stays in place and its
+    /// velocity only enters the no-slip condition (a lid or a belt).
+    #[serde(default)]
+    pub moves: bool,
     /// Initial temperature in K. Giving it to any phase makes the scene a heat scene;
     /// on a wall phase it is a fixed (Dirichlet) temperature, and a wall phase
     /// without one is adiabatic.

@@ -62,6 +62,14 @@ fn couette_2d_moving_wall_200_steps() {
     assert_bit_identical("couette_2d", &[], 200);
 }
 
+/// A gate lifted out of the tank (moving wall particles, wall pass and neighbour
+/// sort on moving walls), and a lid that slides along a periodic axis, wrapping.
+#[test]
+fn moving_walls_200_steps() {
+    assert_bit_identical("dam_break_gate_2d", &[], 200);
+    assert_bit_identical("couette_2d", &common::TRANSLATING_LID, 200);
+}
+
 /// Periodic on both axes: no wall particles, so no wall pass.
 #[test]
 fn fully_periodic_without_wall_pass_100_steps() {

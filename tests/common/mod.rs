@@ -59,3 +59,14 @@ pub fn scratch(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch folder");
     dir
 }
+
+/// `--set` overrides that turn couette_2d's lid into a moving wall: it translates
+/// at 2.5 mm/s (100 times the scene's lid velocity, so it travels 10 Δx in the
+/// scene's 0.2 s and wraps across the periodic x axis), with the sound speed (10 U)
+/// and the background pressure (5 ρ c²) raised to match.
+pub const TRANSLATING_LID: [&str; 4] = [
+    "phases.lid.moves=true",
+    "phases.lid.velocity=[2.5e-3, 0.0]",
+    "materials.fluid.sound_speed=2.5e-2",
+    "background_pressure=3.125",
+];

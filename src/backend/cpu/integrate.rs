@@ -2,7 +2,9 @@
 //! transport velocity of Adami (2013):
 //!   u^{n+½} = u^n + ½Δt a^n,   r^{n+1} = r^n + Δt (u^{n+½} + ½Δt a_b^n),
 //!   u^{n+1} = u^{n+½} + ½Δt a^{n+1}.
-//! Walls do not move. Positions wrap on periodic axes.
+//! Walls stay in place, except those of a moving phase (`moves`), which drift
+//! with their prescribed velocity: r^{n+1} = r^n + Δt u_wall. Positions wrap on
+//! periodic axes.
 
 use crate::params::Params;
 use crate::state::State;
@@ -17,7 +19,15 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
         .zip(st.vel.par_iter_mut())
         .enumerate()
         .for_each(|(i, (x, v))| {
-            if pr.is_wall(phase[i]) {
+            let ph = phase[i];
+            if pr.is_wall(ph) {
+                if pr.wall_moves(ph) {
+                    let w = pr.phase_b[ph as usize];
+                    for c in 0..3 {
+                        x[c] += dt * w[c];
+                        wrap_periodic(pr, x, c);
+                    }
+                }
                 return;
             }
             let a = acc[i];
@@ -25,15 +35,21 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
             for c in 0..3 {
                 v[c] += hdt * a[c];
                 x[c] += dt * (v[c] + hdt * ab[c]);
-                if pr.grid[3] & (1 << c) != 0 {
-                    if x[c] >= pr.period[c] {
-                        x[c] -= pr.period[c];
-                    } else if x[c] < 0.0 {
-                        x[c] += pr.period[c];
-                    }
-                }
+                wrap_periodic(pr, x, c);
             }
         });
+}
+
+/// Brings coordinate `c` back into [0, period) on a periodic axis.
+#[inline(always)]
+fn wrap_periodic(pr: &Params, x: &mut [f32; 4], c: usize) {
+    if pr.grid[3] & (1 << c) != 0 {
+        if x[c] >= pr.period[c] {
+            x[c] -= pr.period[c];
+        } else if x[c] < 0.0 {
+            x[c] += pr.period[c];
+        }
+    }
 }
 
 /// Second half kick, then the mushy-zone sink of J22 (11)–(13) for liquids in a
@@ -64,6 +80,38 @@ pub fn kick(pr: &Params, st: &mut State) {
 #[cfg(test)]
 mod tests {
     use crate::params::Params;
+
+    /// A moving wall particle drifts by Δt u_wall whatever its acceleration, and
+    /// wraps on a periodic axis; a standing wall particle keeps its place.
+    #[test]
+    fn moving_wall_drifts_with_its_velocity_and_wraps() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/couette_2d.toml"
+        );
+        let sets = [
+            "phases.lid.moves=true".to_string(),
+            "phases.lid.velocity=[2.0e-3, 0.0]".to_string(),
+        ];
+        let l = crate::run::load(path, &sets).unwrap();
+        let pr = Params::new(&l.model, l.state.len() as u32);
+        let lid = l.model.phase_index("lid").unwrap() as u32;
+        let wall = l.model.phase_index("wall").unwrap() as u32;
+        let mut st = l.state.clone();
+        st.sim.dt = 0.01;
+        let (a, b) = (
+            (0..st.len()).find(|&i| st.phase[i] == lid).unwrap(),
+            (0..st.len()).find(|&i| st.phase[i] == wall).unwrap(),
+        );
+        st.pos[a][0] = pr.period[0] - 1.0e-5;
+        st.acc[a] = [1.0; 4];
+        st.acc_b[a] = [1.0; 4];
+        let (xa, xb) = (st.pos[a], st.pos[b]);
+        super::kick_drift(&pr, &mut st);
+        assert_eq!(st.pos[a][0], (xa[0] + 0.01f32 * 2.0e-3) - pr.period[0]);
+        assert_eq!(st.pos[a][1], xa[1]);
+        assert_eq!(st.pos[b], xb);
+    }
 
     /// J22 (12): with no force, a liquid particle at liquid fraction f_l leaves the
     /// kick with v / (1 + Δt C (1 − f_l)); fully liquid particles keep v.

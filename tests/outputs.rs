@@ -238,9 +238,11 @@ fn hard_kill_leaves_mcap_readable_to_its_last_chunk() {
 }
 
 /// 200 steps straight against 100 + resume 100: the final states are identical.
+/// The scene is the dam break with a moving gate, so a resumed run must also pick
+/// up the gate where it was.
 fn resume_is_bit_identical(backend: &str) {
     let dir = scratch(&format!("outputs_resume_{backend}"));
-    let sc = common::scene("dam_break_2d");
+    let sc = common::scene("dam_break_gate_2d");
     let ck = |name: &str| dir.join(name);
     let run = |extra: &[&str], ckdir: &Path| {
         let mut args = vec!["run", "--backend", backend, "--steps"];

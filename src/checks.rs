@@ -285,10 +285,7 @@ impl Checker {
         experiment: DamBreakExperiment,
         figures: &mut Vec<(String, f64)>,
     ) -> (String, f64, Vec<String>) {
-        let (table, name) = match experiment {
-            DamBreakExperiment::KoshizukaOka => (&KOSHIZUKA_OKA[..], "Koshizuka-Oka"),
-            DamBreakExperiment::MartinMoyce => (&MARTIN_MOYCE[..], "Martin-Moyce"),
-        };
+        let Experiment { table, name, .. } = Experiment::of(experiment);
         let scale = (2.0 * g_mag(m) / width).sqrt();
         let mut worst: f64 = 0.0;
         let mut details = Vec::new();
@@ -563,9 +560,14 @@ fn linear_fit_at_zero(pts: &[(f64, f64)]) -> f64 {
     my - slope * mx
 }
 
+/// Linear interpolation in a table sorted by x, held at the end values outside it.
+/// Repeated x (a run's final state is observed twice) are skipped.
 fn interpolate(table: &[(f64, f64)], x: f64) -> f64 {
+    if x <= table[0].0 {
+        return table[0].1;
+    }
     for w in table.windows(2) {
-        if x <= w[1].0 {
+        if x <= w[1].0 && w[1].0 > w[0].0 {
             let f = (x - w[0].0) / (w[1].0 - w[0].0);
             return w[0].1 + f * (w[1].1 - w[0].1);
         }
@@ -692,8 +694,8 @@ pub struct ReleaseDelayFit {
 
 /// Fits the release delay of `run` (T, Z), sorted by T and starting at the release,
 /// to the experiment's points `data` with 0 < T ≤ `t_max`. Before the run's first
-/// sample the column is at rest (its first Z). None when no point lies in range or
-/// the run ends before the last of them.
+/// sample the column is at rest (`interpolate` holds the first Z). None when no
+/// point lies in range or the run ends before the last of them.
 pub fn fit_release_delay(
     run: &[(f64, f64)],
     data: &[(f64, f64)],
@@ -711,7 +713,7 @@ pub fn fit_release_delay(
     let worst = |delay: f64| {
         points
             .iter()
-            .map(|&(t, z)| (run_front(run, t - delay) - z).abs() / z)
+            .map(|&(t, z)| (interpolate(run, t - delay) - z).abs() / z)
             .fold(0.0, f64::max)
     };
     let unshifted = worst(0.0);
@@ -731,22 +733,6 @@ pub fn fit_release_delay(
     })
 }
 
-/// Z of a run at T by linear interpolation between its samples; the first sample's
-/// Z before it (the column at rest). Repeated times (the final state is observed
-/// twice) are skipped.
-fn run_front(run: &[(f64, f64)], t: f64) -> f64 {
-    if t <= run[0].0 {
-        return run[0].1;
-    }
-    for w in run.windows(2) {
-        if t <= w[1].0 && w[1].0 > w[0].0 {
-            let f = (t - w[0].0) / (w[1].0 - w[0].0);
-            return w[0].1 + f * (w[1].1 - w[0].1);
-        }
-    }
-    run[run.len() - 1].1
-}
-
 /// One details line (and two figures) for the fitted release delay against `exp`.
 fn release_delay_line(
     run: &[(f64, f64)],
@@ -754,12 +740,12 @@ fn release_delay_line(
     details: &mut Vec<String>,
     figures: &mut Vec<(String, f64)>,
 ) {
-    let (table, name, key, width): (&[(f64, f64)], _, _, f64) = match exp {
-        DamBreakExperiment::KoshizukaOka => {
-            (&KOSHIZUKA_OKA, "Koshizuka-Oka", "koshizuka_oka", 0.146)
-        }
-        DamBreakExperiment::MartinMoyce => (&MARTIN_MOYCE, "Martin-Moyce", "martin_moyce", 0.05715),
-    };
+    let Experiment {
+        table,
+        name,
+        key,
+        width,
+    } = Experiment::of(exp);
     let Some(f) = fit_release_delay(run, table, DAM_BREAK_T_MAX) else {
         return;
     };
@@ -777,6 +763,35 @@ fn release_delay_line(
     ));
     figures.push((format!("release_delay_{key}"), f.delay));
     figures.push((format!("release_delay_error_{key}"), f.error));
+}
+
+/// One dam-break experiment: its front data, names and column width.
+struct Experiment {
+    table: &'static [(f64, f64)],
+    name: &'static str,
+    /// Name in figure keys.
+    key: &'static str,
+    /// Column width a or L (m).
+    width: f64,
+}
+
+impl Experiment {
+    fn of(exp: DamBreakExperiment) -> Self {
+        match exp {
+            DamBreakExperiment::KoshizukaOka => Experiment {
+                table: &KOSHIZUKA_OKA,
+                name: "Koshizuka-Oka",
+                key: "koshizuka_oka",
+                width: 0.146,
+            },
+            DamBreakExperiment::MartinMoyce => Experiment {
+                table: &MARTIN_MOYCE,
+                name: "Martin-Moyce",
+                key: "martin_moyce",
+                width: 2.25 * 0.0254,
+            },
+        }
+    }
 }
 
 /// Surge front Z = z/L against T = t sqrt(2g/L) for a column of width L and height 2L:

@@ -1,3 +1,4 @@
+// uses: params bindings kernel grid phase
 // Summation density rho_i = m_i sum_j W_ij (F22 §3.3) and EOS p = c²(rho - rho0)
 // (F22 (3)), clamped at 0 with the pressure floor. Twin of src/backend/cpu/density.rs.
 
@@ -20,17 +21,10 @@ fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let ci = cell_coord(pi);
     let zr = z_range();
     var sum = 0.0;
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let r2 = len2(min_image(pi, pos[j]));
-                    if (r2 < P.kern.w) {
-                        sum = sum + kernel_w(sqrt(r2));
-                    }
-                }
-            }
+    #for_each_neighbor(ci, zr, j) {
+        let r2 = len2(min_image(pi, pos[j]));
+        if (r2 < P.kern.w) {
+            sum = sum + kernel_w(sqrt(r2));
         }
     }
     let r = mass[i] * sum;

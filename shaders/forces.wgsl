@@ -1,3 +1,4 @@
+// uses: params bindings consts kernel grid phase
 // Pressure + viscous forces F22 (23), transport-velocity background pressure
 // (Adami 2013) and gravity. Twin of src/backend/cpu/forces.rs, which explains the
 // wall treatment.
@@ -40,74 +41,67 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     if (alpha0 > 0.0) {
         alpha_i = alpha0 * min(h * surface[i].w, c_one());
     }
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let d = min_image(pi, pos[j]);
-                    let r2 = len2(d);
-                    if (r2 < P.kern.w && r2 > 0.0) {
-                        let r = sqrt(r2);
-                        let dwdr = kernel_dw(r);
-                        let ph_j = phase[j];
-                        let mat_j = P.phase_a[ph_j];
-                        let wall = mat_j.w >= KIND_WALL;
-                        let p_j = press[j];
-                        var rho_j = rho[j];
-                        var m_j = mass[j];
-                        var eta_j = mat_j.z;
-                        if (wall) {
-                            rho_j = mat_i.x + p_j / mat_i.y;
-                            m_j = m_i;
-                            eta_j = eta_i;
-                        }
-                        let slip = wall && P.phase_b[ph_j].w != 0.0;
-                        let vol_j = m_j / rho_j;
-                        let vv = vol_i * vol_i + vol_j * vol_j;
-                        let p_avg = (rho_j * p_i + rho_i * p_j) / (rho_i + rho_j);
-                        let eta_sum = eta_i + eta_j;
-                        var eta_avg = 0.0;
-                        if (eta_sum > 0.0 && !slip) {
-                            eta_avg = c_two() * eta_i * eta_j / eta_sum;
-                        }
-                        let fp = -p_avg * dwdr / r;
-                        let fv = eta_avg * dwdr / r;
-                        let fbg = -pb * dwdr / r;
-                        let v_j = vel[j];
-                        for (var a = 0u; a < 3u; a++) {
-                            let u = v_i[a] - v_j[a];
-                            f[a] = f[a] + vv * (fp * d[a] + fv * u);
-                            fb[a] = fb[a] + vv * (fbg * d[a]);
-                        }
-                        if (alpha0 > 0.0 && !wall) {
-                            let alpha = (alpha_i + alpha0 * min(h * surface[j].w, c_one())) * c_half();
-                            let s = interface_viscosity(m_i, m_j, rho_i, rho_j, mat_i.y, mat_j.y, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
-                            for (var a = 0u; a < 3u; a++) {
-                                f[a] = f[a] + s * d[a];
-                            }
-                        }
-                        if (viscous_heating) {
-                            // Power the pair's viscous force dissipates: fluid pairs
-                            // share F.(u_i - u_j); against a wall it is F.(u_i - U_wall)
-                            // with the wall's real velocity (the mirrored one is a ghost).
-                            var w = v_j.xyz;
-                            var share = c_half();
-                            if (wall) {
-                                w = P.phase_b[ph_j].xyz;
-                                share = c_one();
-                            }
-                            let ux = v_i.x - v_j.x;
-                            let uy = v_i.y - v_j.y;
-                            let uz = v_i.z - v_j.z;
-                            let wx = v_i.x - w.x;
-                            let wy = v_i.y - w.y;
-                            let wz = v_i.z - w.z;
-                            let uw = ux * wx + uy * wy + uz * wz;
-                            heating = heating - share * vv * fv * uw;
-                        }
-                    }
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kern.w && r2 > 0.0) {
+            let r = sqrt(r2);
+            let dwdr = kernel_dw(r);
+            let ph_j = phase[j];
+            let mat_j = P.phase_a[ph_j];
+            let wall = mat_j.w >= KIND_WALL;
+            let p_j = press[j];
+            var rho_j = rho[j];
+            var m_j = mass[j];
+            var eta_j = mat_j.z;
+            if (wall) {
+                rho_j = mat_i.x + p_j / mat_i.y;
+                m_j = m_i;
+                eta_j = eta_i;
+            }
+            let slip = wall && P.phase_b[ph_j].w != 0.0;
+            let vol_j = m_j / rho_j;
+            let vv = vol_i * vol_i + vol_j * vol_j;
+            let p_avg = (rho_j * p_i + rho_i * p_j) / (rho_i + rho_j);
+            let eta_sum = eta_i + eta_j;
+            var eta_avg = 0.0;
+            if (eta_sum > 0.0 && !slip) {
+                eta_avg = c_two() * eta_i * eta_j / eta_sum;
+            }
+            let fp = -p_avg * dwdr / r;
+            let fv = eta_avg * dwdr / r;
+            let fbg = -pb * dwdr / r;
+            let v_j = vel[j];
+            for (var a = 0u; a < 3u; a++) {
+                let u = v_i[a] - v_j[a];
+                f[a] = f[a] + vv * (fp * d[a] + fv * u);
+                fb[a] = fb[a] + vv * (fbg * d[a]);
+            }
+            if (alpha0 > 0.0 && !wall) {
+                let alpha = (alpha_i + alpha0 * min(h * surface[j].w, c_one())) * c_half();
+                let s = interface_viscosity(m_i, m_j, rho_i, rho_j, mat_i.y, mat_j.y, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] + s * d[a];
                 }
+            }
+            if (viscous_heating) {
+                // Power the pair's viscous force dissipates: fluid pairs
+                // share F.(u_i - u_j); against a wall it is F.(u_i - U_wall)
+                // with the wall's real velocity (the mirrored one is a ghost).
+                var w = v_j.xyz;
+                var share = c_half();
+                if (wall) {
+                    w = P.phase_b[ph_j].xyz;
+                    share = c_one();
+                }
+                let ux = v_i.x - v_j.x;
+                let uy = v_i.y - v_j.y;
+                let uz = v_i.z - v_j.z;
+                let wx = v_i.x - w.x;
+                let wy = v_i.y - w.y;
+                let wz = v_i.z - w.z;
+                let uw = ux * wx + uy * wy + uz * wz;
+                heating = heating - share * vv * fv * uw;
             }
         }
     }

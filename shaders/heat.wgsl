@@ -1,3 +1,4 @@
+// uses: params bindings consts kernel grid phase math
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
@@ -28,19 +29,12 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
     let zr = z_range();
     var sw = 0.0;
     var stw = 0.0;
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let r2 = len2(min_image(pi, pos[j]));
-                    if (r2 < P.kern.w && conducts(phase[j])) {
-                        let wk = kernel_w(sqrt(r2));
-                        sw = sw + wk;
-                        stw = stw + heat[j].y * wk;
-                    }
-                }
-            }
+    #for_each_neighbor(ci, zr, j) {
+        let r2 = len2(min_image(pi, pos[j]));
+        if (r2 < P.kern.w && conducts(phase[j])) {
+            let wk = kernel_w(sqrt(r2));
+            sw = sw + wk;
+            stw = stw + heat[j].y * wk;
         }
     }
     let t_wall = P.phase_d[ph].x;
@@ -66,31 +60,24 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let ci = cell_coord(pi);
     let zr = z_range();
     var sum = 0.0;
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let r2 = len2(min_image(pi, pos[j]));
-                    if (r2 >= P.kern.w || r2 <= 0.0) { continue; }
-                    let ph_j = phase[j];
-                    var k_ij = 0.0;
-                    if (conducts(ph_j)) {
-                        let k_j = conductivity(ph_j, heat[j].z);
-                        // Ordered operands: both sides of a pair get the same bits.
-                        k_ij = c_four() * min(k_i, k_j) * max(k_i, k_j) / (k_i + k_j);
-                    } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
-                        k_ij = c_two() * k_i;
-                    } else {
-                        continue;
-                    }
-                    let r = sqrt(r2);
-                    let f = kernel_dw(r) * r / (r2 + eta2);
-                    let v_j = mass[j] / heat_density(ph_j, j);
-                    sum = sum + v_j * k_ij * (t_i - heat[j].y) * f;
-                }
-            }
+    #for_each_neighbor(ci, zr, j) {
+        let r2 = len2(min_image(pi, pos[j]));
+        if (r2 >= P.kern.w || r2 <= 0.0) { continue; }
+        let ph_j = phase[j];
+        var k_ij = 0.0;
+        if (conducts(ph_j)) {
+            let k_j = conductivity(ph_j, heat[j].z);
+            // Ordered operands: both sides of a pair get the same bits.
+            k_ij = c_four() * min(k_i, k_j) * max(k_i, k_j) / (k_i + k_j);
+        } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
+            k_ij = c_two() * k_i;
+        } else {
+            continue;
         }
+        let r = sqrt(r2);
+        let f = kernel_dw(r) * r / (r2 + eta2);
+        let v_j = mass[j] / heat_density(ph_j, j);
+        sum = sum + v_j * k_ij * (t_i - heat[j].y) * f;
     }
     // The laser pass left its source (W/kg) in heat.w.
     var source = 0.0;

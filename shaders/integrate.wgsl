@@ -1,3 +1,4 @@
+// uses: params bindings consts grid phase
 // Velocity Verlet with transport velocity. Twin of src/backend/cpu/integrate.rs.
 
 @compute @workgroup_size(64)

@@ -1,3 +1,4 @@
+// uses: params bindings consts kernel grid phase
 // Interface normal and surface delta of the condensed material, R18 (3.25)-(3.27).
 // Twin of src/backend/cpu/interface.rs (equations there). surface[i] = (n, delta),
 // surface[n + i].x = Shepard sum Gamma_i.
@@ -27,17 +28,10 @@ fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         let pi = pos[i];
         let ci = cell_coord(pi);
         let zr = z_range();
-        for (var dz = -zr; dz <= zr; dz++) {
-            for (var dy = -1; dy <= 1; dy++) {
-                for (var seg = 0u; seg < row_segments(); seg++) {
-                    let rg = row_segment(ci, dy, dz, seg);
-                    for (var j = rg.x; j < rg.y; j++) {
-                        let r2 = len2(min_image(pi, pos[j]));
-                        if (r2 < P.kern.w && condensed(phase[j])) {
-                            g = g + volume(j) * kernel_w(sqrt(r2));
-                        }
-                    }
-                }
+        #for_each_neighbor(ci, zr, j) {
+            let r2 = len2(min_image(pi, pos[j]));
+            if (r2 < P.kern.w && condensed(phase[j])) {
+                g = g + volume(j) * kernel_w(sqrt(r2));
             }
         }
     }
@@ -66,24 +60,17 @@ fn gas_interface(i: u32) {
     let ci = cell_coord(pi);
     let zr = z_range();
     var g = vec3<f32>(0.0, 0.0, 0.0);
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let d = min_image(pi, pos[j]);
-                    let r2 = len2(d);
-                    if (r2 >= P.kern.w || r2 <= 0.0 || condensed(phase[j]) == side) { continue; }
-                    let rho_j = vol_density(j);
-                    let v_j = mass[j] / rho_j;
-                    let r = sqrt(r2);
-                    let f = (v_i * v_i + v_j * v_j) * (rho_i / (rho_i + rho_j)) * kernel_dw(r) / r;
-                    g.x = g.x + f * d.x;
-                    g.y = g.y + f * d.y;
-                    g.z = g.z + f * d.z;
-                }
-            }
-        }
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 >= P.kern.w || r2 <= 0.0 || condensed(phase[j]) == side) { continue; }
+        let rho_j = vol_density(j);
+        let v_j = mass[j] / rho_j;
+        let r = sqrt(r2);
+        let f = (v_i * v_i + v_j * v_j) * (rho_i / (rho_i + rho_j)) * kernel_dw(r) / r;
+        g.x = g.x + f * d.x;
+        g.y = g.y + f * d.y;
+        g.z = g.z + f * d.z;
     }
     g = vec3<f32>(g.x / v_i, g.y / v_i, g.z / v_i);
     let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
@@ -113,22 +100,15 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let ci = cell_coord(pi);
     let zr = z_range();
     var g = vec3<f32>(0.0, 0.0, 0.0);
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let d = min_image(pi, pos[j]);
-                    let r2 = len2(d);
-                    if (r2 >= P.kern.w || r2 <= 0.0 || !condensed(phase[j])) { continue; }
-                    let r = sqrt(r2);
-                    let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j].x) * kernel_dw(r) / r;
-                    g.x = g.x + f * d.x;
-                    g.y = g.y + f * d.y;
-                    g.z = g.z + f * d.z;
-                }
-            }
-        }
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 >= P.kern.w || r2 <= 0.0 || !condensed(phase[j])) { continue; }
+        let r = sqrt(r2);
+        let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j].x) * kernel_dw(r) / r;
+        g.x = g.x + f * d.x;
+        g.y = g.y + f * d.y;
+        g.z = g.z + f * d.z;
     }
     let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
     if (delta > c_tenth() * P.kern.y) {

@@ -1,3 +1,4 @@
+// uses: params bindings consts grid phase math
 // Beer-Lambert laser absorption with column binning (R18 §3.2.2), beam down the
 // last axis. Twin of src/backend/cpu/laser.rs (equations there).
 
@@ -39,18 +40,11 @@ fn laser_bins(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let ci = cell_coord(c);
     let zr = z_range();
     var sum = 0.0;
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var seg = 0u; seg < row_segments(); seg++) {
-                let rg = row_segment(ci, dy, dz, seg);
-                for (var j = rg.x; j < rg.y; j++) {
-                    let d = min_image(c, pos[j]);
-                    if (len2(d) < P.kern.w && absorbs(phase[j])) {
-                        let v = mass[j] / P.phase_a[phase[j]].x;
-                        sum = sum + cic(d) * v;
-                    }
-                }
-            }
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(c, pos[j]);
+        if (len2(d) < P.kern.w && absorbs(phase[j])) {
+            let v = mass[j] / P.phase_a[phase[j]].x;
+            sum = sum + cic(d) * v;
         }
     }
     bins[b] = vec2<f32>(sum, 0.0);

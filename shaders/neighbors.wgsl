@@ -1,3 +1,4 @@
+// uses: params bindings grid phase
 // Neighbour search. Twin of src/backend/cpu/neighbors.rs.
 // 1. cell_keys: key (cell, index) per particle; padding keys sort last.
 // 2. bitonic sort over the padded keys. Keys are unique, so the result is the single

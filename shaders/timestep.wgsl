@@ -1,3 +1,4 @@
+// uses: params bindings consts phase
 // Max |u|² and |a|² over fluid particles by a fixed two-level tree (per-workgroup,
 // then one workgroup over the partials), then the F22 (42) time step.
 // Twin of src/backend/cpu/timestep.rs.

@@ -1,3 +1,4 @@
+// uses: params bindings kernel grid phase
 // Generalized wall boundary (Adami, Hu & Adams 2012): each wall particle gathers
 // pressure and velocity from its fluid neighbours. Twin of src/backend/cpu/wall.rs.
 
@@ -27,25 +28,18 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
     }
     if (gather) {
-        for (var dz = -zr; dz <= zr; dz++) {
-            for (var dy = -1; dy <= 1; dy++) {
-                for (var seg = 0u; seg < row_segments(); seg++) {
-                    let rg = row_segment(ci, dy, dz, seg);
-                    for (var j = rg.x; j < rg.y; j++) {
-                        let d = min_image(pi, pos[j]);
-                        let r2 = len2(d);
-                        if (r2 < P.kern.w && !is_wall(phase[j])) {
-                            let wk = kernel_w(sqrt(r2));
-                            sw = sw + wk;
-                            sp = sp + press[j] * wk;
-                            let rw = rho[j] * wk;
-                            let v = vel[j];
-                            for (var a = 0u; a < 3u; a++) {
-                                sr[a] = sr[a] + rw * d[a];
-                                sv[a] = sv[a] + v[a] * wk;
-                            }
-                        }
-                    }
+        #for_each_neighbor(ci, zr, j) {
+            let d = min_image(pi, pos[j]);
+            let r2 = len2(d);
+            if (r2 < P.kern.w && !is_wall(phase[j])) {
+                let wk = kernel_w(sqrt(r2));
+                sw = sw + wk;
+                sp = sp + press[j] * wk;
+                let rw = rho[j] * wk;
+                let v = vel[j];
+                for (var a = 0u; a < 3u; a++) {
+                    sr[a] = sr[a] + rw * d[a];
+                    sv[a] = sv[a] + v[a] * wk;
                 }
             }
         }

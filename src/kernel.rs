@@ -1,4 +1,4 @@
-//! Smoothing kernels, CPU side. Twin of shaders/kernel.wgsl: same formulas in the
+//! Smoothing kernels, CPU side. Twin of shaders/lib/kernel.wgsl: same formulas in the
 //! same operation order (no mul_add), so both give the same bits (DESIGN rule 1).
 
 use crate::params::Params;

@@ -30,7 +30,7 @@ pub const HEAT_SWITCH_SHIFT: u32 = 8;
 pub const LASER_BEER_LAMBERT: f32 = 1.0;
 pub const LASER_SURFACE: f32 = 2.0;
 
-/// Mirrors `struct Params` in shaders/common.wgsl field for field.
+/// Mirrors `struct Params` in shaders/lib/params.wgsl field for field.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct Params {
@@ -106,8 +106,8 @@ pub struct Params {
 /// The wall pass divides by Σ W + ε with ε this fraction of W(0) (src/backend/cpu/wall.rs).
 pub const WALL_WEIGHT_FLOOR: f64 = 1e-9;
 
-/// Mirrors the `c_*` and portable-math constants in shaders/common.wgsl and
-/// shaders/portable_math.wgsl; src/portable_math.rs uses the same f32 values.
+/// Mirrors the `c_*` and portable-math constants in shaders/lib/params.wgsl and
+/// shaders/lib/math.wgsl; src/portable_math.rs uses the same f32 values.
 pub const SHADER_CONSTS: [[f32; 4]; 8] = {
     use crate::portable_math as pm;
     [

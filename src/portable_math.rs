@@ -1,5 +1,5 @@
 //! Portable exp, ln and pow: built from + − × ÷, floor and bit manipulation only,
-//! written once here and once in shaders/portable_math.wgsl with the same operations
+//! written once here and once in shaders/lib/math.wgsl with the same operations
 //! in the same order, so both backends give the same bits (DESIGN rule 2; built-in
 //! WGSL exp/pow differ from Rust by a few ULP). The shader reads every coefficient
 //! from the parameter block (see params::SHADER_CONSTS); these are the same f32s.

@@ -4,6 +4,7 @@
 
 mod context;
 pub mod probe;
+pub mod shaders;
 
 pub use context::{AdapterChoice, GpuContext};
 
@@ -17,21 +18,6 @@ const WG: u32 = 64;
 const REDUCE_WG: u32 = 256;
 /// Stride between sort-stage uniforms (the usual min_uniform_buffer_offset_alignment).
 const STAGE_STRIDE: u64 = 256;
-
-const SHADERS: [(&str, &str); 9] = [
-    ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
-    ("density", include_str!("../../../shaders/density.wgsl")),
-    ("wall", include_str!("../../../shaders/wall.wgsl")),
-    ("forces", include_str!("../../../shaders/forces.wgsl")),
-    ("integrate", include_str!("../../../shaders/integrate.wgsl")),
-    ("timestep", include_str!("../../../shaders/timestep.wgsl")),
-    ("heat", include_str!("../../../shaders/heat.wgsl")),
-    ("laser", include_str!("../../../shaders/laser.wgsl")),
-    ("interface", include_str!("../../../shaders/interface.wgsl")),
-];
-const COMMON: &str = include_str!("../../../shaders/common.wgsl");
-/// Portable exp/ln/pow, prepended to every pass (twin of src/portable_math.rs).
-const PORTABLE_MATH: &str = include_str!("../../../shaders/portable_math.wgsl");
 
 /// (pipeline name, shader file, entry point)
 pub const ENTRY_POINTS: [(&str, &str, &str); 21] = [
@@ -620,12 +606,16 @@ fn main_bind_group(
     })
 }
 
-/// Each pass's complete WGSL source (shared definitions and portable math first), by
-/// shader file name. Public so that a test can validate them without an adapter.
+/// Each pass's complete WGSL source (its libraries first, neighbour walks
+/// expanded), by shader file name. Public so that a test can validate them without
+/// an adapter.
 pub fn shader_sources() -> Vec<(&'static str, String)> {
-    SHADERS
+    shaders::PASSES
         .iter()
-        .map(|(name, src)| (*name, format!("{COMMON}\n{PORTABLE_MATH}\n{src}")))
+        .map(|(name, src)| {
+            let full = shaders::compose(src).unwrap_or_else(|e| panic!("shaders/{name}.wgsl: {e}"));
+            (*name, full)
+        })
         .collect()
 }
 

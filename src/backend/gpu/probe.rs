@@ -1,8 +1,8 @@
 //! Evaluate a WGSL expression of `a`, `b`, `c` element-wise on the device, with the
-//! shared shader code (common.wgsl, portable_math.wgsl) and a parameter block bound
+//! shared shader code (every library in shaders/lib/) and a parameter block bound
 //! as in the real passes. Used by the tests that pin down the adapter's arithmetic.
 
-use super::{GpuContext, COMMON, PORTABLE_MATH};
+use super::GpuContext;
 use crate::params::Params;
 use wgpu::util::DeviceExt;
 
@@ -15,9 +15,9 @@ pub fn eval_f32(
     c: &[f32],
 ) -> Vec<f32> {
     let n = a.len();
+    let libs = super::shaders::all_libraries();
     let src = format!(
-        "{COMMON}
-{PORTABLE_MATH}
+        "{libs}
 @group(1) @binding(0) var<storage, read_write> va: array<f32>;
 @group(1) @binding(1) var<storage, read_write> vb: array<f32>;
 @group(1) @binding(2) var<storage, read_write> vc: array<f32>;

@@ -1,6 +1,7 @@
+// uses: params consts
 // Portable exp, ln and pow. Twin of src/portable_math.rs (same operations, same
 // order); coefficients come from the parameter block so the compiler cannot
-// reassociate them (see common.wgsl).
+// reassociate them (see consts.wgsl).
 
 fn pm_exp(x: f32) -> f32 {
     if (x != x) { return x; }

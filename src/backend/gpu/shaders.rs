@@ -1,0 +1,206 @@
+//! WGSL composition: each pass file names the library files it uses on its first
+//! line (`// uses: params bindings kernel grid`), and the host prepends those (with
+//! what they use in turn) in one fixed order, then expands the neighbour-walk
+//! template. Plain text, no preprocessor crate: naga_oil does not follow naga 30.
+//!
+//! The neighbour walk is written once, here. A pass writes
+//!
+//! ```text
+//!     #for_each_neighbor(ci, zr, j) {
+//!         ...body, with j the sorted index of a candidate neighbour...
+//!     }
+//! ```
+//!
+//! with `ci` the particle's cell and `zr` its z reach (`z_range()`), and the
+//! template expands to the dz / dy / row-segment / j loops every pass had written
+//! out before (issue 14), character for character, so the compiled loops are the
+//! ones that were measured on hardware. The Rust twin is
+//! `backend::cpu::neighbors::for_each_neighbor`: same cells, same order.
+
+/// Library files, in the order they are composed (each after what it uses).
+const LIBS: [(&str, &str); 7] = [
+    ("params", include_str!("../../../shaders/lib/params.wgsl")),
+    (
+        "bindings",
+        include_str!("../../../shaders/lib/bindings.wgsl"),
+    ),
+    ("consts", include_str!("../../../shaders/lib/consts.wgsl")),
+    ("math", include_str!("../../../shaders/lib/math.wgsl")),
+    ("kernel", include_str!("../../../shaders/lib/kernel.wgsl")),
+    ("grid", include_str!("../../../shaders/lib/grid.wgsl")),
+    ("phase", include_str!("../../../shaders/lib/phase.wgsl")),
+];
+
+/// The pass files (one per compute pass, named as in the pass table).
+pub const PASSES: [(&str, &str); 9] = [
+    ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
+    ("density", include_str!("../../../shaders/density.wgsl")),
+    ("wall", include_str!("../../../shaders/wall.wgsl")),
+    ("forces", include_str!("../../../shaders/forces.wgsl")),
+    ("integrate", include_str!("../../../shaders/integrate.wgsl")),
+    ("timestep", include_str!("../../../shaders/timestep.wgsl")),
+    ("heat", include_str!("../../../shaders/heat.wgsl")),
+    ("laser", include_str!("../../../shaders/laser.wgsl")),
+    ("interface", include_str!("../../../shaders/interface.wgsl")),
+];
+
+const WALK_DIRECTIVE: &str = "#for_each_neighbor(";
+
+/// The libraries a source names on its `// uses:` line.
+fn uses(src: &str) -> Vec<&str> {
+    src.lines()
+        .next()
+        .and_then(|l| l.strip_prefix("// uses:"))
+        .map(|l| l.split_whitespace().collect())
+        .unwrap_or_default()
+}
+
+/// `wanted` and everything it uses, in LIBS order.
+fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
+    let mut need = [false; LIBS.len()];
+    let mut stack: Vec<&str> = wanted.to_vec();
+    while let Some(name) = stack.pop() {
+        let k = LIBS
+            .iter()
+            .position(|(n, _)| *n == name)
+            .ok_or_else(|| format!("no WGSL library '{name}' (shaders/lib/)"))?;
+        if !need[k] {
+            need[k] = true;
+            stack.extend(uses(LIBS[k].1));
+        }
+    }
+    Ok((0..LIBS.len()).filter(|&k| need[k]).collect())
+}
+
+/// A pass's complete source: its libraries, then the pass with every neighbour
+/// walk expanded.
+pub fn compose(pass: &str) -> Result<String, String> {
+    let mut out = String::new();
+    for k in resolve(&uses(pass))? {
+        out.push_str(LIBS[k].1);
+        out.push('\n');
+    }
+    out.push_str(&expand_walks(pass)?);
+    Ok(out)
+}
+
+/// Every library (for the arithmetic probe, which is not a pass).
+pub fn all_libraries() -> String {
+    let names: Vec<&str> = LIBS.iter().map(|(n, _)| *n).collect();
+    let mut out = String::new();
+    for k in resolve(&names).expect("LIBS resolves") {
+        out.push_str(LIBS[k].1);
+        out.push('\n');
+    }
+    out
+}
+
+/// Replace each `#for_each_neighbor(cell, reach, j) {` … `}` block (closed by the
+/// first `}` line at the directive's indentation) with the walk's loops.
+pub fn expand_walks(src: &str) -> Result<String, String> {
+    let lines: Vec<&str> = src.lines().collect();
+    let mut out = Vec::with_capacity(lines.len() + 16);
+    let mut k = 0;
+    while k < lines.len() {
+        let line = lines[k];
+        let indent = &line[..line.len() - line.trim_start().len()];
+        let Some(args) = line.trim_start().strip_prefix(WALK_DIRECTIVE) else {
+            out.push(line.to_string());
+            k += 1;
+            continue;
+        };
+        let args = args.strip_suffix(") {").ok_or_else(|| {
+            format!(
+                "line {}: '{WALK_DIRECTIVE}cell, reach, j) {{' expected",
+                k + 1
+            )
+        })?;
+        let a: Vec<&str> = args.split(',').map(str::trim).collect();
+        let [cell, reach, j] = a[..] else {
+            return Err(format!(
+                "line {}: the walk takes (cell, reach, index)",
+                k + 1
+            ));
+        };
+        let close = format!("{indent}}}");
+        let end = (k + 1..lines.len())
+            .find(|&e| lines[e] == close)
+            .ok_or_else(|| format!("line {}: neighbour walk not closed", k + 1))?;
+        let i = |extra: usize| format!("{indent}{}", " ".repeat(extra));
+        out.push(format!(
+            "{}for (var dz = -{reach}; dz <= {reach}; dz++) {{",
+            i(0)
+        ));
+        out.push(format!("{}for (var dy = -1; dy <= 1; dy++) {{", i(4)));
+        out.push(format!(
+            "{}for (var seg = 0u; seg < row_segments(); seg++) {{",
+            i(8)
+        ));
+        out.push(format!(
+            "{}let rg = row_segment({cell}, dy, dz, seg);",
+            i(12)
+        ));
+        out.push(format!(
+            "{}for (var {j} = rg.x; {j} < rg.y; {j}++) {{",
+            i(12)
+        ));
+        for body in &lines[k + 1..end] {
+            // Body lines move 12 columns right, into the innermost loop.
+            out.push(if body.is_empty() {
+                String::new()
+            } else {
+                format!("            {body}")
+            });
+        }
+        for extra in [12, 8, 4, 0] {
+            out.push(format!("{}}}", i(extra)));
+        }
+        k = end + 1;
+    }
+    let mut s = out.join("\n");
+    if src.ends_with('\n') {
+        s.push('\n');
+    }
+    Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn walk_expands_to_the_loops_with_the_body_innermost() {
+        let src = "fn f() {\n    #for_each_neighbor(ci, zr, j) {\n        s = s + 1.0;\n    }\n}\n";
+        let want = "fn f() {
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var seg = 0u; seg < row_segments(); seg++) {
+                let rg = row_segment(ci, dy, dz, seg);
+                for (var j = rg.x; j < rg.y; j++) {
+                    s = s + 1.0;
+                }
+            }
+        }
+    }
+}
+";
+        assert_eq!(expand_walks(src).unwrap(), want);
+    }
+
+    #[test]
+    fn an_unclosed_walk_or_a_missing_library_is_an_error() {
+        assert!(expand_walks("    #for_each_neighbor(ci, zr, j) {\n        x;\n").is_err());
+        assert!(expand_walks("    #for_each_neighbor(ci, j) {\n    }\n").is_err());
+        assert!(compose("// uses: params nonsense\n").is_err());
+    }
+
+    #[test]
+    fn libraries_come_before_their_users_and_once() {
+        // kernel uses consts, which uses params: all three, in LIBS order.
+        let src = compose("// uses: kernel\nfn f() {}\n").unwrap();
+        let at = |needle: &str| src.find(needle).unwrap();
+        assert!(at("struct Params") < at("fn c_half") && at("fn c_half") < at("fn kernel_w"));
+        assert_eq!(src.matches("struct Params").count(), 1);
+        assert!(!src.contains("fn pm_exp"), "math not named, not included");
+    }
+}

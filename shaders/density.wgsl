@@ -3,9 +3,8 @@
 // (F22 (3)), clamped at 0 with the pressure floor. Twin of src/backend/cpu/density.rs.
 
 fn equation_of_state(ph: u32, r: f32) -> f32 {
-    let m = P.phase_a[ph];
-    let p = m.y * (r - m.x);
-    if ((P.grid.w & FLAG_PRESSURE_FLOOR) != 0u) {
+    let p = P.phases[ph].c2 * (r - P.phases[ph].rho0);
+    if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
         return max(p, 0.0);
     }
     return p;
@@ -14,7 +13,7 @@ fn equation_of_state(ph: u32, r: f32) -> f32 {
 @compute @workgroup_size(64)
 fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph = phase[i];
     if (is_wall(ph)) { return; }
     let pi = pos[i];
@@ -23,7 +22,7 @@ fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     var sum = 0.0;
     #for_each_neighbor(ci, zr, j) {
         let r2 = len2(min_image(pi, pos[j]));
-        if (r2 < P.kern.w) {
+        if (r2 < P.kernel.support2) {
             sum = sum + kernel_w(sqrt(r2));
         }
     }

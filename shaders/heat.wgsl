@@ -4,15 +4,15 @@
 
 // Conductivity at liquid fraction fl, linear between the solid and liquid values.
 fn conductivity(ph: u32, fl: f32) -> f32 {
-    let ks = P.phase_c[ph].x;
-    return ks + fl * (P.phase_g[ph].y - ks);
+    let ks = P.phases[ph].conductivity;
+    return ks + fl * (P.phases[ph].liquid_conductivity - ks);
 }
 
 // Density for a particle's volume: summation density for fluids, rho0 for solids
 // and walls.
 fn heat_density(ph: u32, i: u32) -> f32 {
     if (is_wall(ph)) {
-        return P.phase_a[ph].x;
+        return P.phases[ph].rho0;
     }
     return rho[i];
 }
@@ -21,7 +21,7 @@ fn heat_density(ph: u32, i: u32) -> f32 {
 @compute @workgroup_size(64)
 fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph = phase[i];
     if (conducts(ph) || (heat_flags(ph) & HEAT_DIRICHLET) == 0u) { return; }
     let pi = pos[i];
@@ -31,13 +31,13 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
     var stw = 0.0;
     #for_each_neighbor(ci, zr, j) {
         let r2 = len2(min_image(pi, pos[j]));
-        if (r2 < P.kern.w && conducts(phase[j])) {
+        if (r2 < P.kernel.support2 && conducts(phase[j])) {
             let wk = kernel_w(sqrt(r2));
             sw = sw + wk;
             stw = stw + heat[j].y * wk;
         }
     }
-    let t_wall = P.phase_d[ph].x;
+    let t_wall = P.phases[ph].fixed_temperature;
     var hv = heat[i];
     if (sw > 0.0) {
         hv.y = c_two() * t_wall - stw / sw;
@@ -50,19 +50,19 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
 @compute @workgroup_size(64)
 fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph_i = phase[i];
     if (!conducts(ph_i)) { return; }
     let k_i = conductivity(ph_i, heat[i].z);
     let t_i = heat[i].y;
-    let eta2 = P.heat.y;
+    let eta2 = P.kernel.eta2;
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
     var sum = 0.0;
     #for_each_neighbor(ci, zr, j) {
         let r2 = len2(min_image(pi, pos[j]));
-        if (r2 >= P.kern.w || r2 <= 0.0) { continue; }
+        if (r2 >= P.kernel.support2 || r2 <= 0.0) { continue; }
         let ph_j = phase[j];
         var k_ij = 0.0;
         if (conducts(ph_j)) {
@@ -81,14 +81,14 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     // The laser pass left its source (W/kg) in heat.w.
     var source = 0.0;
-    if (P.laser.w != 0.0) {
+    if (P.laser.model != 0u) {
         source = heat[i].w;
     }
-    if ((P.grid.w & FLAG_VISCOUS_HEATING) != 0u) {
+    if ((P.sizes.flags & FLAG_VISCOUS_HEATING) != 0u) {
         source = source + acc[i].w;
     }
     var loss = 0.0;
-    if (P.heat.w != 0.0) {
+    if ((P.sizes.flags & FLAG_INTERFACE) != 0u) {
         loss = surface_loss(ph_i, t_i, surface[i].w);
     }
     let rate = source - loss + sum / heat_density(ph_i, i);
@@ -101,52 +101,53 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 
 // Evaporation F22 (18), (10) and radiation through the free surface, W/kg.
 fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
-    let e = P.phase_e[ph];
-    let f = P.phase_f[ph];
     var flux = 0.0;
-    if (e.x > 0.0) {
-        let pv = e.x * pm_exp(-(e.y * (c_one() / t - e.z)));
-        let mdot = f.z * pv * sqrt(f.y / t);
-        flux = flux + mdot * (e.w + P.phase_g[ph].z * (t - f.x));
+    if (P.phases[ph].evap_pressure > 0.0) {
+        let pv = P.phases[ph].evap_pressure * pm_exp(-(P.phases[ph].evap_temperature * (c_one() / t - P.phases[ph].inv_boiling_temperature)));
+        let mdot = P.phases[ph].recondensation * pv * sqrt(P.phases[ph].vapor_constant / t);
+        flux = flux + mdot * (P.phases[ph].evap_latent_heat + P.phases[ph].liquid_heat_capacity * (t - P.phases[ph].evap_enthalpy_reference));
     }
-    if (f.w > 0.0) {
-        flux = flux + f.w * (t * t * t * t - P.iface.y);
+    if (P.phases[ph].emissivity_sb > 0.0) {
+        flux = flux + P.phases[ph].emissivity_sb * (t * t * t * t - P.surfaces.ambient_t4);
     }
-    return flux * delta / P.phase_a[ph].x;
+    return flux * delta / P.phases[ph].rho0;
 }
 
 @compute @workgroup_size(64)
 fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     var hv = heat[i];
     let h = hv.x;
-    let c = P.phase_c[ph];
-    let d = P.phase_d[ph];
+    let c_s = P.phases[ph].heat_capacity;
+    let band = P.phases[ph].band_enthalpy;
+    let t_s = P.phases[ph].solidus;
+    let t_l = P.phases[ph].liquidus;
     let flags = heat_flags(ph);
     // Stored enthalpy is relative to h(T_ref) (T_ref = solidus when melting).
     if ((flags & HEAT_MELTS) == 0u) {
-        hv.y = c.z + h / c.y;
+        hv.y = P.phases[ph].reference_temperature + h / c_s;
         hv.z = select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u);
     } else if (h <= 0.0) {
-        hv.y = d.x + h / c.y;
+        hv.y = t_s + h / c_s;
         hv.z = 0.0;
-    } else if (h >= c.w) {
-        hv.y = d.y + (h - c.w) / P.phase_g[ph].z;
+    } else if (h >= band) {
+        hv.y = t_l + (h - band) / P.phases[ph].liquid_heat_capacity;
         hv.z = 1.0;
     } else {
-        let a = P.phase_g[ph].w;
-        let x = c_two() * h / (d.z + sqrt(d.z * d.z + c_four() * a * h));
-        hv.y = d.x + x;
-        hv.z = x / (d.y - d.x);
+        let a = P.phases[ph].capacity_slope;
+        let b = P.phases[ph].band_capacity;
+        let x = c_two() * h / (b + sqrt(b * b + c_four() * a * h));
+        hv.y = t_s + x;
+        hv.z = x / (t_l - t_s);
     }
     heat[i] = hv;
     // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).
-    let switch_to = (flags >> 8u) & 15u;
+    let switch_to = (flags >> HEAT_SWITCH_SHIFT) & 15u;
     if (switch_to == 0u) { return; }
-    let solid = P.phase_a[ph].w == KIND_SOLID;
+    let solid = P.phases[ph].kind == KIND_SOLID;
     if (solid && hv.z >= 0.5) {
         phase[i] = switch_to - 1u;
     } else if (!solid && hv.z < 0.5) {

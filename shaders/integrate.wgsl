@@ -4,13 +4,13 @@
 @compute @workgroup_size(64)
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph = phase[i];
     let dt = sim.dt;
     if (is_wall(ph)) {
         // A moving wall drifts with its prescribed velocity; others stay.
         if (wall_moves(ph)) {
-            let w = P.phase_b[ph];
+            let w = P.phases[ph].velocity;
             var xw = pos[i];
             for (var c = 0u; c < 3u; c++) {
                 xw[c] = wrap_periodic(xw[c] + dt * w[c], c);
@@ -34,11 +34,11 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 
 // Brings coordinate x of axis c back into [0, period) on a periodic axis.
 fn wrap_periodic(x: f32, c: u32) -> f32 {
-    if ((P.grid.w & (1u << c)) != 0u) {
-        if (x >= P.period[c]) {
-            return x - P.period[c];
+    if ((P.sizes.flags & (1u << c)) != 0u) {
+        if (x >= P.grid.period[c]) {
+            return x - P.grid.period[c];
         } else if (x < 0.0) {
-            return x + P.period[c];
+            return x + P.grid.period[c];
         }
     }
     return x;
@@ -47,7 +47,7 @@ fn wrap_periodic(x: f32, c: u32) -> f32 {
 @compute @workgroup_size(64)
 fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     if (is_wall(phase[i])) { return; }
     let hdt = c_half() * sim.dt;
     let a = acc[i];
@@ -56,7 +56,7 @@ fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         v[c] = v[c] + hdt * a[c];
     }
     // Mushy-zone sink J22 (12): v / (1 + dt C (1 - f_l)), semi-implicit.
-    let sink = P.phase_g[phase[i]].x;
+    let sink = P.phases[phase[i]].mushy_damping;
     if (sink > 0.0) {
         let damp = c_one() + sim.dt * sink * (c_one() - heat[i].z);
         for (var c = 0u; c < 3u; c++) {

@@ -3,25 +3,23 @@
 // Twin of src/backend/cpu/interface.rs (equations there). surface[i] = (n, delta),
 // surface[n + i].x = Shepard sum Gamma_i.
 
-const KIND_GAS_I: f32 = 1.0;
-
 fn condensed(ph: u32) -> bool {
-    return P.phase_a[ph].w != KIND_GAS_I;
+    return P.phases[ph].kind != KIND_GAS;
 }
 
 // Twin of Params::gets_gas_interface.
 fn gets_gas_interface(ph: u32) -> bool {
-    return conducts(ph) || (P.iface.w > 0.0 && !is_wall(ph));
+    return conducts(ph) || (P.flow.interface_viscosity > 0.0 && !is_wall(ph));
 }
 
 fn volume(j: u32) -> f32 {
-    return mass[j] / P.phase_a[phase[j]].x;
+    return mass[j] / P.phases[phase[j]].rho0;
 }
 
 @compute @workgroup_size(64)
 fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    let n = P.counts.x;
+    let n = P.sizes.n_particles;
     if (i >= n) { return; }
     var g = 0.0;
     if (condensed(phase[i])) {
@@ -30,7 +28,7 @@ fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         let zr = z_range();
         #for_each_neighbor(ci, zr, j) {
             let r2 = len2(min_image(pi, pos[j]));
-            if (r2 < P.kern.w && condensed(phase[j])) {
+            if (r2 < P.kernel.support2 && condensed(phase[j])) {
                 g = g + volume(j) * kernel_w(sqrt(r2));
             }
         }
@@ -41,7 +39,7 @@ fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 fn vol_density(j: u32) -> f32 {
     let ph = phase[j];
     if (is_wall(ph)) {
-        return P.phase_a[ph].x;
+        return P.phases[ph].rho0;
     }
     return rho[j];
 }
@@ -63,7 +61,7 @@ fn gas_interface(i: u32) {
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
         let r2 = len2(d);
-        if (r2 >= P.kern.w || r2 <= 0.0 || condensed(phase[j]) == side) { continue; }
+        if (r2 >= P.kernel.support2 || r2 <= 0.0 || condensed(phase[j]) == side) { continue; }
         let rho_j = vol_density(j);
         let v_j = mass[j] / rho_j;
         let r = sqrt(r2);
@@ -74,8 +72,8 @@ fn gas_interface(i: u32) {
     }
     g = vec3<f32>(g.x / v_i, g.y / v_i, g.z / v_i);
     let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
-    if (delta > c_tenth() * P.kern.y) {
-        surface[i] = vec4<f32>(g.x / delta, g.y / delta, g.z / delta, delta * P.iface.x);
+    if (delta > c_tenth() * P.kernel.inv_h) {
+        surface[i] = vec4<f32>(g.x / delta, g.y / delta, g.z / delta, delta * P.surfaces.inv_kappa);
     } else {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     }
@@ -84,9 +82,9 @@ fn gas_interface(i: u32) {
 @compute @workgroup_size(64)
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    let n = P.counts.x;
+    let n = P.sizes.n_particles;
     if (i >= n) { return; }
-    if (P.iface.z != 0.0) {
+    if ((P.sizes.flags & FLAG_GAS_INTERFACE) != 0u) {
         gas_interface(i);
         return;
     }
@@ -103,7 +101,7 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
         let r2 = len2(d);
-        if (r2 >= P.kern.w || r2 <= 0.0 || !condensed(phase[j])) { continue; }
+        if (r2 >= P.kernel.support2 || r2 <= 0.0 || !condensed(phase[j])) { continue; }
         let r = sqrt(r2);
         let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j].x) * kernel_dw(r) / r;
         g.x = g.x + f * d.x;
@@ -111,8 +109,8 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         g.z = g.z + f * d.z;
     }
     let delta = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
-    if (delta > c_tenth() * P.kern.y) {
-        let scaled = delta * P.iface.x;
+    if (delta > c_tenth() * P.kernel.inv_h) {
+        let scaled = delta * P.surfaces.inv_kappa;
         surface[i] = vec4<f32>(-g.x / delta, -g.y / delta, -g.z / delta, scaled);
     } else {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);

@@ -42,7 +42,7 @@ fn pair_low(p: u32, j: u32) -> u32 {
 fn cell_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i >= arrayLength(&keys)) { return; }
-    if (i < P.counts.x) {
+    if (i < P.sizes.n_particles) {
         keys[i] = vec2<u32>(cell_index(cell_coord(pos[i])), i);
     } else {
         keys[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
@@ -96,7 +96,7 @@ fn bitonic_local(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id)
 @compute @workgroup_size(64)
 fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = thread_index(gid, nwg);
-    if (k >= P.counts.x) { return; }
+    if (k >= P.sizes.n_particles) { return; }
     let s = keys[k].y;
     s_pos[k] = pos[s];
     s_vel[k] = vel[s];
@@ -105,7 +105,7 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     s_mass[k] = mass[s];
     s_phase[k] = phase[s];
     s_pid[k] = pid[s];
-    if (P.heat.z != 0.0) {
+    if ((P.sizes.flags & FLAG_HEAT) != 0u) {
         s_heat[k] = heat[s];
     }
 }
@@ -113,7 +113,7 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 @compute @workgroup_size(64)
 fn cell_bounds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = thread_index(gid, nwg);
-    let n = P.counts.x;
+    let n = P.sizes.n_particles;
     if (k >= n) { return; }
     let c = keys[k].x;
     if (k == 0u || keys[k - 1u].x != c) {

@@ -21,7 +21,7 @@ fn reduce(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id) wid: v
     let g = wid.x + wid.y * nwg.x;
     let i = g * RWG + t;
     var m = vec2<f32>(0.0, 0.0);
-    if (i < P.counts.x && !is_wall(phase[i])) {
+    if (i < P.sizes.n_particles && !is_wall(phase[i])) {
         let v = vel[i];
         let a = acc[i];
         m = vec2<f32>(v.x * v.x + v.y * v.y + v.z * v.z, a.x * a.x + a.y * a.y + a.z * a.z);
@@ -35,7 +35,7 @@ fn reduce(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id) wid: v
 
 @compute @workgroup_size(256)
 fn finalize(@builtin(local_invocation_index) t: u32) {
-    let groups = (P.counts.x + RWG - 1u) / RWG;
+    let groups = (P.sizes.n_particles + RWG - 1u) / RWG;
     var m = vec2<f32>(0.0, 0.0);
     for (var g = t; g < groups; g += RWG) {
         m = max(m, partials[g]);
@@ -51,19 +51,19 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
     sim.time = sim.time + sim.dt;
     sim.umax2 = umax2;
     sim.amax2 = amax2;
-    let h = P.dtp.x;
-    let speed = P.dtp.y + sqrt(umax2);
+    let h = P.kernel.h;
+    let speed = P.time_step.max_sound_speed + sqrt(umax2);
     var dt = 3.40282347e38;
     if (speed > 0.0) {
         dt = c_quarter() * h / speed;
     }
     var which = 0u;
-    if (P.dtp.z < dt) {
-        dt = P.dtp.z;
+    if (P.time_step.viscous_limit < dt) {
+        dt = P.time_step.viscous_limit;
         which = 1u;
     }
-    if (P.heat.x < dt) {
-        dt = P.heat.x;
+    if (P.time_step.conduction_limit < dt) {
+        dt = P.time_step.conduction_limit;
         which = 4u;
     }
     if (amax2 > 0.0) {
@@ -73,8 +73,8 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
             which = 2u;
         }
     }
-    if (P.dtp.w > 0.0) {
-        dt = P.dtp.w;
+    if (P.time_step.fixed_dt > 0.0) {
+        dt = P.time_step.fixed_dt;
         which = 3u;
     }
     sim.dt = dt;

@@ -5,7 +5,7 @@
 @compute @workgroup_size(64)
 fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.counts.x) { return; }
+    if (i >= P.sizes.n_particles) { return; }
     let ph = phase[i];
     if (!is_wall(ph)) { return; }
     let pi = pos[i];
@@ -31,7 +31,7 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         #for_each_neighbor(ci, zr, j) {
             let d = min_image(pi, pos[j]);
             let r2 = len2(d);
-            if (r2 < P.kern.w && !is_wall(phase[j])) {
+            if (r2 < P.kernel.support2 && !is_wall(phase[j])) {
                 let wk = kernel_w(sqrt(r2));
                 sw = sw + wk;
                 sp = sp + press[j] * wk;
@@ -44,18 +44,17 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
-    let b = P.phase_b[ph];
-    let m = P.phase_a[ph];
+    let b = P.phases[ph].velocity;
     // Regularised Shepard division (the CPU twin explains why): as Σ W -> 0 the
     // pressure goes to 0 and the velocity to the wall's own, continuously.
-    let g = P.gravity;
-    let den = sw + P.wall.x;
+    let g = P.flow.gravity;
+    let den = sw + P.flow.wall_weight_floor;
     var p = (sp + (g.x * sr.x + g.y * sr.y + g.z * sr.z)) / den;
     let v = vec4<f32>(b.x + (b.x * sw - sv.x) / den, b.y + (b.y * sw - sv.y) / den, b.z + (b.z * sw - sv.z) / den, 0.0);
-    if ((P.grid.w & FLAG_PRESSURE_FLOOR) != 0u) {
+    if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
         p = max(p, 0.0);
     }
-    rho[i] = m.x + p / m.y;
+    rho[i] = P.phases[ph].rho0 + p / P.phases[ph].c2;
     press[i] = p;
     vel[i] = v;
 }

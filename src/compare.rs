@@ -65,14 +65,14 @@ pub struct ToleranceScales {
 
 impl ToleranceScales {
     pub fn new(p: &Params) -> ToleranceScales {
-        let pb = p.gravity[3].abs() as f64;
-        let h = p.kernel[0] as f64;
+        let pb = p.flow.background_pressure.abs() as f64;
+        let h = p.kernel.h as f64;
         let (mut pressure, mut acceleration) = (pb, 0.0f64);
-        for ph in p.phase_a.iter().filter(|a| a[0] > 0.0) {
-            let p0 = ph[0] as f64 * ph[1] as f64;
+        for ph in p.phases.iter().filter(|ph| ph.rho0 > 0.0) {
+            let p0 = ph.rho0 as f64 * ph.c2 as f64;
             pressure = pressure.max(p0);
-            if ph[3] < KIND_WALL {
-                acceleration = acceleration.max(p0.max(pb) / (ph[0] as f64 * h));
+            if ph.kind < KIND_WALL {
+                acceleration = acceleration.max(p0.max(pb) / (ph.rho0 as f64 * h));
             }
         }
         ToleranceScales {

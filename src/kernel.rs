@@ -13,11 +13,11 @@ fn p5(t: f32) -> f32 {
     t * t * t * t * t
 }
 
-/// W(r) for the kernel chosen in `params.counts[3]`.
+/// W(r) for the kernel chosen in `params.kernel.kind`.
 #[inline(always)]
 pub fn w(pr: &Params, r: f32) -> f32 {
-    let (sigma, h_inv) = (pr.kernel[2], pr.kernel[1]);
-    match pr.counts[3] {
+    let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
+    match pr.kernel.kind {
         0 => w_quintic(sigma, h_inv, r),
         1 => w_wendland_c2(sigma, h_inv, r),
         _ => w_cubic(sigma, h_inv, r),
@@ -62,8 +62,8 @@ fn w_cubic(sigma: f32, h_inv: f32, r: f32) -> f32 {
 /// loop without branches that the compiler vectorises (4 lanes with SSE2), and
 /// then added in order.
 pub fn sum_w(pr: &Params, r2: &[f32]) -> f32 {
-    let (sigma, h_inv) = (pr.kernel[2], pr.kernel[1]);
-    match pr.counts[3] {
+    let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
+    match pr.kernel.kind {
         0 => sum_in_order(r2, |r| w_quintic(sigma, h_inv, r)),
         1 => sum_in_order(r2, |r| w_wendland_c2(sigma, h_inv, r)),
         _ => sum_in_order(r2, |r| w_cubic(sigma, h_inv, r)),
@@ -86,12 +86,12 @@ fn sum_in_order(r2: &[f32], w: impl Fn(f32) -> f32) -> f32 {
     sum
 }
 
-/// dW/dr for the kernel chosen in `params.counts[3]`.
+/// dW/dr for the kernel chosen in `params.kernel.kind`.
 #[inline(always)]
 pub fn dw(pr: &Params, r: f32) -> f32 {
-    let sigma_h = pr.kernel[2] * pr.kernel[1];
-    let q = r * pr.kernel[1];
-    match pr.counts[3] {
+    let sigma_h = pr.kernel.sigma * pr.kernel.inv_h;
+    let q = r * pr.kernel.inv_h;
+    match pr.kernel.kind {
         0 => {
             let t1 = (1.0 - q).max(0.0);
             let t2 = (2.0 - q).max(0.0);
@@ -124,13 +124,11 @@ mod tests {
 
     fn params(kind: KernelKind, dim: u32, h: f64) -> Params {
         let mut p = Params::zeroed();
-        p.counts = [0, 0, dim, kind.code()];
-        p.kernel = [
-            h as f32,
-            (1.0 / h) as f32,
-            kernel_sigma(kind, dim, h) as f32,
-            0.0,
-        ];
+        p.sizes.dim = dim;
+        p.kernel.kind = kind.code();
+        p.kernel.h = h as f32;
+        p.kernel.inv_h = (1.0 / h) as f32;
+        p.kernel.sigma = kernel_sigma(kind, dim, h) as f32;
         p
     }
 

@@ -1,125 +1,350 @@
 //! The f32 parameter block both backends read (DESIGN rule 6): computed once on the
 //! host in f64 and rounded to f32, so the CPU twin and the WGSL pass see the same bits.
+//!
+//! Every member has a name, the same in Rust and in shaders/lib/params.wgsl;
+//! tests/params_layout.rs holds the two layouts against each other through naga.
+//! Booleans live as named bits in `sizes.flags` (scene-wide) and `Phase::flags`
+//! (per phase); nothing is read by position.
 
+use crate::gpu_layout::gpu_struct;
 use crate::model::{Model, MAX_LASER_POINTS, MAX_PHASES};
 use crate::scene::{KernelKind, PhaseKind, Slip};
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use std::f64::consts::PI;
 
+/// `sizes.flags`: axis a is periodic when bit a is set.
 pub const FLAG_PERIODIC_X: u32 = 1;
 pub const FLAG_PERIODIC_Y: u32 = 2;
 pub const FLAG_PERIODIC_Z: u32 = 4;
+/// The equation of state clamps negative pressure to 0.
 pub const FLAG_PRESSURE_FLOOR: u32 = 8;
 /// Forces pass writes the viscous dissipation (W/kg) into acc.w; heat adds it.
 pub const FLAG_VISCOUS_HEATING: u32 = 16;
+/// The scene carries temperature (heat passes run).
+pub const FLAG_HEAT: u32 = 32;
+/// The scene needs interface normals and surface deltas (interface pass).
+pub const FLAG_INTERFACE: u32 = 64;
+/// F22's gas-interface form (19)–(20): the scene has gas particles beside the
+/// condensed phase, so no Shepard sums are needed.
+pub const FLAG_GAS_INTERFACE: u32 = 128;
 
-pub const KIND_LIQUID: f32 = 0.0;
-pub const KIND_GAS: f32 = 1.0;
-pub const KIND_WALL: f32 = 2.0;
-pub const KIND_SOLID: f32 = 3.0;
+/// `Phase::kind`.
+pub const KIND_LIQUID: u32 = 0;
+pub const KIND_GAS: u32 = 1;
+pub const KIND_WALL: u32 = 2;
+pub const KIND_SOLID: u32 = 3;
 
-/// `phase_d.w` flag bits (stored as an exact small integer in f32).
+/// `Phase::flags` bits.
 pub const HEAT_DIRICHLET: u32 = 1;
 pub const HEAT_MELTS: u32 = 2;
 pub const HEAT_LIQUID: u32 = 4;
-/// Bits 8..11 of the flags: 1 + the phase this one switches to on melting or
-/// solidifying (0: none).
+/// Bits 8..11: 1 + the phase this one switches to on melting or solidifying (0: none).
 pub const HEAT_SWITCH_SHIFT: u32 = 8;
+/// A wall phase with free slip (no viscous term against it).
+pub const PHASE_FREE_SLIP: u32 = 1 << 12;
+/// A wall phase whose particles drift with its velocity.
+pub const PHASE_MOVES: u32 = 1 << 13;
 
-/// `laser.w` model codes.
-pub const LASER_BEER_LAMBERT: f32 = 1.0;
-pub const LASER_SURFACE: f32 = 2.0;
+/// `Laser::model` codes (0: no laser).
+pub const LASER_BEER_LAMBERT: u32 = 1;
+pub const LASER_SURFACE: u32 = 2;
 
-/// Mirrors `struct Params` in shaders/lib/params.wgsl field for field.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub struct Params {
-    /// n_particles, n_cells, dimension, kernel code (0 quintic, 1 Wendland C2, 2 cubic).
-    pub counts: [u32; 4],
-    /// cells along x, y, z; flags (periodic axes, pressure floor).
-    pub grid: [u32; 4],
-    /// 1 / cell size per axis.
-    pub cell_inv: [f32; 4],
-    /// Period length per axis (0 where not periodic).
-    pub period: [f32; 4],
-    /// Half the period per axis, for the minimum-image test.
-    pub half_period: [f32; 4],
-    /// h, 1/h, kernel normalisation σ, support radius squared.
-    pub kernel: [f32; 4],
-    /// Gravity xyz, background pressure p_b.
-    pub gravity: [f32; 4],
-    /// h, max sound speed, viscous limit 0.125 h²/ν (f32::MAX if inviscid), fixed Δt (0: adaptive).
-    pub dt: [f32; 4],
-    /// Per phase: ρ0, c², η, kind (0 liquid, 1 gas, 2 wall).
-    pub phase_a: [[f32; 4]; MAX_PHASES],
-    /// Per phase: wall velocity xyz, slip (0 no-slip, 1 free-slip).
-    pub phase_b: [[f32; 4]; MAX_PHASES],
-    /// Per phase (heat): solid conductivity k_s, solid heat capacity c_s, reference
-    /// temperature T_ref (particles store h − h(T_ref), `Thermal::reference_temperature`),
-    /// band enthalpy h(T_l) − h(T_s) for a melting material.
-    pub phase_c: [[f32; 4]; MAX_PHASES],
-    /// Per phase (heat): solidus T_s, liquidus T_l, b = c_s + L/(T_l − T_s), flags
-    /// (HEAT_DIRICHLET, HEAT_MELTS, HEAT_LIQUID). A Dirichlet wall keeps its fixed
-    /// temperature in the first slot.
-    pub phase_d: [[f32; 4]; MAX_PHASES],
-    /// Surface losses per phase: evaporation C_p (Pa), C_T (K), 1/T_v (1/K), h_v (J/kg)
-    /// (all 0 without evaporation).
-    pub phase_e: [[f32; 4]; MAX_PHASES],
-    /// Surface losses per phase: T_h0 (K), C_M, 0.82 c_s, ε σ_B (radiation).
-    pub phase_f: [[f32; 4]; MAX_PHASES],
-    /// Per phase: mushy-zone sink C (1/s, liquids), liquid conductivity k_l, liquid
-    /// heat capacity c_l, a = (c_l − c_s)/(2 (T_l − T_s)) (0 without melting).
-    pub phase_g: [[f32; 4]; MAX_PHASES],
-    /// Heat: conduction Δt limit 0.1 ρ c_p h²/k (f32::MAX without heat), η² = 0.01 h²
-    /// (Cleary–Monaghan regularisation), 1 for a heat scene, 1 when the scene
-    /// needs interface normals (interface pass).
-    pub heat: [f32; 4],
-    /// Laser: absorptivity ζ, beam radius r_w, absorption coefficient a, model
-    /// (0 none, LASER_BEER_LAMBERT, LASER_SURFACE).
-    pub laser: [f32; 4],
-    /// Interface pass: 1/κ, the normalisation of the surface delta (κ = Σ δ V per
-    /// unit area across a planar lattice surface, `surface_delta_integral` or
-    /// `gas_delta_integral`); T_ambient⁴ for radiation; 1 in F22 gas mode (the
-    /// scene has gas particles); F22 (32) interface viscosity α_0^lg (0 = off).
-    pub interface: [f32; 4],
-    /// Laser bins: size (= Δx), peak irradiance per watt (2/(π r_w²) in 3D,
-    /// √(2/π)/r_w in 2D), bin volume Δx^d, column cross-section Δx^(d−1).
-    pub laser_grid: [f32; 4],
-    /// Bins per axis (1 beyond the dimension), path points + 256 × power steps.
-    pub laser_bins: [u32; 4],
-    /// Lower corner of the bin grid in grid-relative coordinates.
-    pub laser_lo: [f32; 4],
-    /// Scan path: time, lateral beam centre (grid-relative), unused.
-    pub laser_path: [[f32; 4]; MAX_LASER_POINTS],
-    /// Power schedule: time, power from then on, unused, unused.
-    pub laser_power: [[f32; 4]; MAX_LASER_POINTS],
+gpu_struct! {
+    /// Counts and scene-wide flags.
+    pub struct Sizes {
+        pub n_particles: u32,
+        pub n_cells: u32,
+        pub dim: u32,
+        /// FLAG_* bits.
+        pub flags: u32,
+    }
+}
+
+gpu_struct! {
+    /// The cell grid (grid-relative coordinates: the domain's lower corner is 0).
+    pub struct Grid {
+        /// Cells along x, y, z (w unused).
+        pub cells: [u32; 4],
+        /// 1 / cell size per axis.
+        pub cell_inv: [f32; 4],
+        /// Period length per axis (0 where not periodic).
+        pub period: [f32; 4],
+        /// Half the period per axis, for the minimum-image test.
+        pub half_period: [f32; 4],
+    }
+}
+
+gpu_struct! {
+    /// The smoothing kernel.
+    pub struct Kernel {
+        /// 0 quintic, 1 Wendland C2, 2 cubic spline (`KernelKind::code`).
+        pub kind: u32,
+        pub h: f32,
+        pub inv_h: f32,
+        /// Normalisation σ (∫W = 1).
+        pub sigma: f32,
+        /// Support radius squared.
+        pub support2: f32,
+        /// η² = 0.01 h², the Cleary–Monaghan regularisation of 1/r² terms.
+        pub eta2: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+    }
+}
+
+gpu_struct! {
+    /// The time-step limits F22 (42) (f32::MAX where a limit does not apply).
+    pub struct TimeStep {
+        /// Largest reference sound speed of the fluid phases.
+        pub max_sound_speed: f32,
+        /// 0.125 h²/ν.
+        pub viscous_limit: f32,
+        /// 0.1 ρ c_p h²/k.
+        pub conduction_limit: f32,
+        /// A fixed Δt (0: adaptive).
+        pub fixed_dt: f32,
+    }
+}
+
+gpu_struct! {
+    /// Body force, transport velocity, interface viscosity and the wall pass.
+    pub struct Flow {
+        /// Gravity xyz (w unused).
+        pub gravity: [f32; 4],
+        /// Transport-velocity background pressure p_b (Adami 2013).
+        pub background_pressure: f32,
+        /// F22 (32) interface viscosity α_0^lg (0 = off).
+        pub interface_viscosity: f32,
+        /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)).
+        pub wall_weight_floor: f32,
+        pub pad0: f32,
+    }
+}
+
+gpu_struct! {
+    /// Interface pass (normals and surface delta).
+    pub struct Surfaces {
+        /// 1/κ, the normalisation of the surface delta (κ = Σ δ V per unit area
+        /// across a planar lattice surface, `surface_delta_integral` or
+        /// `gas_delta_integral`).
+        pub inv_kappa: f32,
+        /// T_ambient⁴ for radiation.
+        pub ambient_t4: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+    }
+}
+
+gpu_struct! {
+    /// One point of the scan path.
+    pub struct PathPoint {
+        pub time: f32,
+        /// Lateral beam centre, grid-relative (y is 0 in 2D).
+        pub x: f32,
+        pub y: f32,
+        pub pad0: f32,
+    }
+}
+
+gpu_struct! {
+    /// One step of the power schedule: `power` from `time` on.
+    pub struct PowerStep {
+        pub time: f32,
+        pub power: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+    }
+}
+
+gpu_struct! {
+    /// The laser: beam, absorption bins and schedule.
+    pub struct Laser {
+        /// Absorptivity ζ.
+        pub absorptivity: f32,
+        /// Beam radius r_w.
+        pub radius: f32,
+        /// Absorption coefficient a (Beer–Lambert).
+        pub absorption: f32,
+        /// 0 none, LASER_BEER_LAMBERT, LASER_SURFACE.
+        pub model: u32,
+        /// Bin size (= Δx).
+        pub bin_size: f32,
+        /// Peak irradiance per watt: 2/(π r_w²) in 3D, √(2/π)/r_w in 2D.
+        pub peak_per_watt: f32,
+        /// Bin volume Δx^d.
+        pub bin_volume: f32,
+        /// Column cross-section Δx^(d−1).
+        pub column_area: f32,
+        /// Bins per axis (1 beyond the dimension; w unused).
+        pub bins: [u32; 4],
+        /// Lower corner of the bin grid, grid-relative.
+        pub lo: [f32; 4],
+        pub path_points: u32,
+        pub power_steps: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+        pub path: [PathPoint; MAX_LASER_POINTS],
+        pub power: [PowerStep; MAX_LASER_POINTS],
+    }
+}
+
+gpu_struct! {
+    /// One phase's material.
+    pub struct Phase {
+        /// Reference density ρ0.
+        pub rho0: f32,
+        /// Sound speed squared c².
+        pub c2: f32,
+        /// Dynamic viscosity η.
+        pub eta: f32,
+        /// KIND_LIQUID, KIND_GAS, KIND_WALL or KIND_SOLID.
+        pub kind: u32,
+        /// Wall velocity xyz (w unused).
+        pub velocity: [f32; 4],
+        /// Solid conductivity k_s.
+        pub conductivity: f32,
+        /// Solid heat capacity c_s.
+        pub heat_capacity: f32,
+        /// T_ref: particles store h − h(T_ref) (`Thermal::reference_temperature`).
+        pub reference_temperature: f32,
+        /// Band enthalpy h(T_l) − h(T_s) of a melting material.
+        pub band_enthalpy: f32,
+        /// Solidus T_s.
+        pub solidus: f32,
+        /// Liquidus T_l.
+        pub liquidus: f32,
+        /// b = c_s + L/(T_l − T_s).
+        pub band_capacity: f32,
+        /// HEAT_*, PHASE_* bits.
+        pub flags: u32,
+        /// Mushy-zone sink C (1/s, liquids).
+        pub mushy_damping: f32,
+        /// Liquid conductivity k_l.
+        pub liquid_conductivity: f32,
+        /// Liquid heat capacity c_l.
+        pub liquid_heat_capacity: f32,
+        /// a = (c_l − c_s)/(2 (T_l − T_s)) (0 without melting).
+        pub capacity_slope: f32,
+        /// Evaporation (all 0 without it): C_p (Pa).
+        pub evap_pressure: f32,
+        /// C_T (K).
+        pub evap_temperature: f32,
+        /// 1/T_v (1/K).
+        pub inv_boiling_temperature: f32,
+        /// h_v (J/kg).
+        pub evap_latent_heat: f32,
+        /// T_h0 (K).
+        pub evap_enthalpy_reference: f32,
+        /// C_M.
+        pub vapor_constant: f32,
+        /// 0.82 c_s (recondensation).
+        pub recondensation: f32,
+        /// ε σ_B (radiation).
+        pub emissivity_sb: f32,
+        /// A Dirichlet wall's fixed temperature.
+        pub fixed_temperature: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
+
+gpu_struct! {
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
     /// shaders read every multiplying or adding literal from here.
-    pub consts: [[f32; 4]; 8],
-    /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)); bit i set
-    /// (as an exact integer) when wall phase i moves with its velocity; unused ×2.
-    pub wall: [f32; 4],
+    pub struct Consts {
+        pub half: f32,
+        pub quarter: f32,
+        pub two: f32,
+        pub one: f32,
+        pub three: f32,
+        pub six: f32,
+        pub fifteen: f32,
+        pub five: f32,
+        pub thirty: f32,
+        pub seventy_five: f32,
+        pub one_and_half: f32,
+        pub three_quarters: f32,
+        pub nine_quarters: f32,
+        pub log2e: f32,
+        pub ln2_hi: f32,
+        pub ln2_lo: f32,
+        pub exp_c0: f32,
+        pub exp_c1: f32,
+        pub exp_c2: f32,
+        pub exp_c3: f32,
+        pub exp_c4: f32,
+        pub exp_c5: f32,
+        pub ln_c0: f32,
+        pub ln_c1: f32,
+        pub ln_c2: f32,
+        pub ln_c3: f32,
+        pub ln_c4: f32,
+        pub four: f32,
+        pub tenth: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
+
+gpu_struct! {
+    /// The whole block, bound as `P` in every pass.
+    pub struct Params {
+        pub sizes: Sizes,
+        pub grid: Grid,
+        pub kernel: Kernel,
+        pub time_step: TimeStep,
+        pub flow: Flow,
+        pub surfaces: Surfaces,
+        pub laser: Laser,
+        pub phases: [Phase; MAX_PHASES],
+        pub consts: Consts,
+    }
 }
 
 /// The wall pass divides by Σ W + ε with ε this fraction of W(0) (src/backend/cpu/wall.rs).
 pub const WALL_WEIGHT_FLOOR: f64 = 1e-9;
 
-/// Mirrors the `c_*` and portable-math constants in shaders/lib/params.wgsl and
-/// shaders/lib/math.wgsl; src/portable_math.rs uses the same f32 values.
-pub const SHADER_CONSTS: [[f32; 4]; 8] = {
+/// The values of `Consts`; src/portable_math.rs uses the same f32 values.
+pub const SHADER_CONSTS: Consts = {
     use crate::portable_math as pm;
-    [
-        [0.5, 0.25, 2.0, 1.0],
-        [3.0, 6.0, 15.0, 5.0],
-        [30.0, 75.0, 1.5, 0.75],
-        [2.25, pm::LOG2E, pm::LN2_HI, pm::LN2_LO],
-        [pm::EXP_C[0], pm::EXP_C[1], pm::EXP_C[2], pm::EXP_C[3]],
-        [pm::EXP_C[4], pm::EXP_C[5], pm::LN_C[0], pm::LN_C[1]],
-        [pm::LN_C[2], pm::LN_C[3], pm::LN_C[4], 4.0],
-        [0.1, 0.0, 0.0, 0.0],
-    ]
+    Consts {
+        half: 0.5,
+        quarter: 0.25,
+        two: 2.0,
+        one: 1.0,
+        three: 3.0,
+        six: 6.0,
+        fifteen: 15.0,
+        five: 5.0,
+        thirty: 30.0,
+        seventy_five: 75.0,
+        one_and_half: 1.5,
+        three_quarters: 0.75,
+        nine_quarters: 2.25,
+        log2e: pm::LOG2E,
+        ln2_hi: pm::LN2_HI,
+        ln2_lo: pm::LN2_LO,
+        exp_c0: pm::EXP_C[0],
+        exp_c1: pm::EXP_C[1],
+        exp_c2: pm::EXP_C[2],
+        exp_c3: pm::EXP_C[3],
+        exp_c4: pm::EXP_C[4],
+        exp_c5: pm::EXP_C[5],
+        ln_c0: pm::LN_C[0],
+        ln_c1: pm::LN_C[1],
+        ln_c2: pm::LN_C[2],
+        ln_c3: pm::LN_C[3],
+        ln_c4: pm::LN_C[4],
+        four: 4.0,
+        tenth: 0.1,
+        pad0: 0.0,
+        pad1: 0.0,
+        pad2: 0.0,
+    }
 };
 
 /// Kernel normalisation σ so that ∫W = 1 (Morris 1997 quintic, Wendland C2, cubic spline).
@@ -139,108 +364,47 @@ pub fn kernel_sigma(kind: KernelKind, dim: u32, h: f64) -> f64 {
 
 impl Params {
     pub fn new(m: &Model, n_particles: u32) -> Params {
-        let mut flags = 0;
-        let mut period = [0.0f32; 4];
-        let mut half = [0.0f32; 4];
-        for a in 0..3 {
-            if m.periodic[a] {
-                flags |= 1 << a;
-                let len = m.domain_hi[a] - m.domain_lo[a];
-                period[a] = len as f32;
-                half[a] = (0.5 * len) as f32;
-            }
-        }
-        if m.pressure_floor {
-            flags |= FLAG_PRESSURE_FLOOR;
-        }
-        if m.viscous_heating && m.is_thermal() {
-            flags |= FLAG_VISCOUS_HEATING;
-        }
-        let mut phase_a = [[0.0f32; 4]; MAX_PHASES];
-        let mut phase_b = [[0.0f32; 4]; MAX_PHASES];
-        for (i, ph) in m.phases.iter().enumerate() {
-            let kind = match ph.kind {
-                PhaseKind::Liquid => KIND_LIQUID,
-                PhaseKind::Gas => KIND_GAS,
-                PhaseKind::Wall => KIND_WALL,
-                PhaseKind::Solid => KIND_SOLID,
-            };
-            let c2 = ph.sound_speed * ph.sound_speed;
-            phase_a[i] = [ph.rho0 as f32, c2 as f32, ph.viscosity as f32, kind];
-            let slip = if ph.slip == Slip::FreeSlip { 1.0 } else { 0.0 };
-            phase_b[i] = [
-                ph.velocity[0] as f32,
-                ph.velocity[1] as f32,
-                ph.velocity[2] as f32,
-                slip,
-            ];
-        }
-        let (phase_c, phase_d) = heat_tables(m);
-        let (phase_e, phase_f) = loss_tables(m);
-        let mut phase_g = [[0.0f32; 4]; MAX_PHASES];
-        for (i, ph) in m.phases.iter().enumerate() {
-            let Some(t) = ph.thermal else { continue };
-            if ph.kind == PhaseKind::Liquid {
-                phase_g[i][0] = t.mushy_damping as f32;
-            }
-            let (kl, cl) = t.liquid;
-            let a = t.melting.map_or(0.0, |(ts, tl, _)| {
-                (cl - t.heat_capacity) / (2.0 * (tl - ts))
-            });
-            phase_g[i][1] = kl as f32;
-            phase_g[i][2] = cl as f32;
-            phase_g[i][3] = a as f32;
-        }
-        let viscous = if m.limits.viscous.is_finite() {
-            m.limits.viscous as f32
-        } else {
-            f32::MAX
+        let mut p = Params::zeroed();
+        p.sizes = Sizes {
+            n_particles,
+            n_cells: m.n_cells() as u32,
+            dim: m.dim,
+            flags: scene_flags(m),
         };
-        let mut p = Params {
-            counts: [n_particles, m.n_cells() as u32, m.dim, m.kernel.code()],
-            grid: [m.grid[0], m.grid[1], m.grid[2], flags],
-            cell_inv: [
-                (1.0 / m.cell_size[0]) as f32,
-                (1.0 / m.cell_size[1]) as f32,
-                (1.0 / m.cell_size[2]) as f32,
-                0.0,
-            ],
-            period,
-            half_period: half,
-            kernel: [
-                m.h as f32,
-                (1.0 / m.h) as f32,
-                kernel_sigma(m.kernel, m.dim, m.h) as f32,
-                (m.support * m.support) as f32,
-            ],
+        p.grid = grid_block(m);
+        p.kernel = Kernel {
+            kind: m.kernel.code(),
+            h: m.h as f32,
+            inv_h: (1.0 / m.h) as f32,
+            sigma: kernel_sigma(m.kernel, m.dim, m.h) as f32,
+            support2: (m.support * m.support) as f32,
+            eta2: (0.01 * m.h * m.h) as f32,
+            pad0: 0.0,
+            pad1: 0.0,
+        };
+        p.time_step = TimeStep {
+            max_sound_speed: m.max_sound_speed() as f32,
+            viscous_limit: finite_or_max(m.limits.viscous),
+            conduction_limit: finite_or_max(m.limits.conduction),
+            fixed_dt: m.fixed_dt.unwrap_or(0.0) as f32,
+        };
+        p.flow = Flow {
             gravity: [
                 m.gravity[0] as f32,
                 m.gravity[1] as f32,
                 m.gravity[2] as f32,
-                m.background_pressure as f32,
+                0.0,
             ],
-            dt: [
-                m.h as f32,
-                m.max_sound_speed() as f32,
-                viscous,
-                m.fixed_dt.unwrap_or(0.0) as f32,
-            ],
-            phase_a,
-            phase_b,
-            phase_c,
-            phase_d,
-            phase_e,
-            phase_f,
-            phase_g,
-            heat: [
-                finite_or_max(m.limits.conduction),
-                (0.01 * m.h * m.h) as f32,
-                if m.is_thermal() { 1.0 } else { 0.0 },
-                if m.needs_interface() { 1.0 } else { 0.0 },
-            ],
-            consts: SHADER_CONSTS,
-            ..laser_block(m)
+            background_pressure: m.background_pressure as f32,
+            interface_viscosity: 0.0,
+            wall_weight_floor: 0.0,
+            pad0: 0.0,
         };
+        for (i, ph) in m.phases.iter().enumerate() {
+            p.phases[i] = phase_block(ph);
+        }
+        p.laser = laser_block(m);
+        p.consts = SHADER_CONSTS;
         if m.needs_interface() {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);
             // The condensed side of F22's interface: a conducting liquid or solid,
@@ -251,54 +415,92 @@ impl Params {
             });
             let kappa = match (gas, condensed) {
                 (Some(g), Some(c)) => {
-                    p.interface[2] = 1.0;
+                    p.sizes.flags |= FLAG_GAS_INTERFACE;
                     gas_delta_integral(&p, m.dx, c.rho0, g.rho0)
                 }
                 _ => surface_delta_integral(&p, m.dx),
             };
-            p.interface[0] = (1.0 / kappa) as f32;
-            p.interface[1] = m.ambient_temperature.powi(4) as f32;
-            p.interface[3] = m.interface_viscosity as f32;
+            p.surfaces.inv_kappa = (1.0 / kappa) as f32;
+            p.surfaces.ambient_t4 = m.ambient_temperature.powi(4) as f32;
+            p.flow.interface_viscosity = m.interface_viscosity as f32;
         }
-        p.wall[0] = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
-        let moving: u32 = m
-            .phases
-            .iter()
-            .enumerate()
-            .filter(|(_, ph)| ph.moves)
-            .map(|(i, _)| 1u32 << i)
-            .sum();
-        p.wall[1] = moving as f32;
+        p.flow.wall_weight_floor = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
         p
     }
     pub fn n(&self) -> usize {
-        self.counts[0] as usize
+        self.sizes.n_particles as usize
+    }
+    pub fn flag(&self, bit: u32) -> bool {
+        self.sizes.flags & bit != 0
+    }
+    /// Axis a is periodic.
+    pub fn periodic(&self, a: usize) -> bool {
+        self.sizes.flags & (FLAG_PERIODIC_X << a) != 0
+    }
+    pub fn phase(&self, phase: u32) -> &Phase {
+        &self.phases[phase as usize]
     }
     /// A wall for the fluid passes: wall or solid particles (they do not move).
     pub fn is_wall(&self, phase: u32) -> bool {
-        self.phase_a[phase as usize][3] >= KIND_WALL
+        self.phases[phase as usize].kind >= KIND_WALL
     }
-    /// A wall phase whose particles move with its velocity (`phase_b`).
+    /// A wall phase whose particles move with its velocity.
     pub fn wall_moves(&self, phase: u32) -> bool {
-        (self.wall[1] as u32 >> phase) & 1 != 0
+        self.phases[phase as usize].flags & PHASE_MOVES != 0
     }
     /// Carries an evolving temperature (liquid, gas or solid in a heat scene).
     pub fn conducts(&self, phase: u32) -> bool {
-        self.heat[2] != 0.0 && self.phase_a[phase as usize][3] != KIND_WALL
+        self.flag(FLAG_HEAT) && self.phases[phase as usize].kind != KIND_WALL
     }
     /// Particles F22's gas-interface pass gives a normal and δ: conducting ones (for
     /// the surface fluxes) and, with the interface viscosity on, every fluid one.
     pub fn gets_gas_interface(&self, phase: u32) -> bool {
-        self.conducts(phase) || (self.interface[3] > 0.0 && !self.is_wall(phase))
+        self.conducts(phase) || (self.flow.interface_viscosity > 0.0 && !self.is_wall(phase))
     }
     pub fn heat_flags(&self, phase: u32) -> u32 {
-        self.phase_d[phase as usize][3] as u32
+        self.phases[phase as usize].flags
     }
     /// The phase a particle of `phase` switches to on melting/solidifying.
     pub fn switch_target(&self, phase: u32) -> Option<u32> {
         let t = (self.heat_flags(phase) >> HEAT_SWITCH_SHIFT) & 15;
         (t > 0).then(|| t - 1)
     }
+}
+
+fn scene_flags(m: &Model) -> u32 {
+    let mut flags = 0;
+    for a in 0..3 {
+        if m.periodic[a] {
+            flags |= FLAG_PERIODIC_X << a;
+        }
+    }
+    if m.pressure_floor {
+        flags |= FLAG_PRESSURE_FLOOR;
+    }
+    if m.viscous_heating && m.is_thermal() {
+        flags |= FLAG_VISCOUS_HEATING;
+    }
+    if m.is_thermal() {
+        flags |= FLAG_HEAT;
+    }
+    if m.needs_interface() {
+        flags |= FLAG_INTERFACE;
+    }
+    flags
+}
+
+fn grid_block(m: &Model) -> Grid {
+    let mut g = Grid::zeroed();
+    for a in 0..3 {
+        g.cells[a] = m.grid[a];
+        g.cell_inv[a] = (1.0 / m.cell_size[a]) as f32;
+        if m.periodic[a] {
+            let len = m.domain_hi[a] - m.domain_lo[a];
+            g.period[a] = len as f32;
+            g.half_period[a] = (0.5 * len) as f32;
+        }
+    }
+    g
 }
 
 /// κ = ∫δ dn of the interface pass's surface delta across a planar surface of the
@@ -309,8 +511,8 @@ impl Params {
 /// κ makes a surface flux ∫ s δ dV deposit exactly s per unit area on a flat
 /// surface (F22 (17)).
 pub fn surface_delta_integral(p: &Params, dx: f64) -> f64 {
-    let dim = p.counts[2] as i64;
-    let support = (p.kernel[3] as f64).sqrt();
+    let dim = p.sizes.dim as i64;
+    let support = (p.kernel.support2 as f64).sqrt();
     let reach = (support / dx).ceil() as i64 + 1;
     let depth = 3 * reach;
     let vol = dx.powi(dim as i32);
@@ -348,7 +550,7 @@ pub fn surface_delta_integral(p: &Params, dx: f64) -> f64 {
                 })
                 .sum();
             // Layers below the normal threshold get no normal and absorb nothing.
-            if g.abs() > 0.1 * p.kernel[1] as f64 {
+            if g.abs() > 0.1 * p.kernel.inv_h as f64 {
                 g.abs() * dx
             } else {
                 0.0
@@ -362,8 +564,8 @@ pub fn surface_delta_integral(p: &Params, dx: f64) -> f64 {
 /// gas (ρ_g, above). The density weight ρ_i/(ρ_i + ρ_j) gives the condensed side
 /// nearly all of the jump (F22 Remark 3) when ρ_c ≫ ρ_g.
 pub fn gas_delta_integral(p: &Params, dx: f64, rho_c: f64, rho_g: f64) -> f64 {
-    let dim = p.counts[2] as i64;
-    let support = (p.kernel[3] as f64).sqrt();
+    let dim = p.sizes.dim as i64;
+    let support = (p.kernel.support2 as f64).sqrt();
     let reach = (support / dx).ceil() as i64 + 1;
     let vol_c = dx.powi(dim as i32);
     // Every lattice site holds volume Δx^d whatever its phase (m = ρ0 Δx^d).
@@ -394,7 +596,7 @@ pub fn gas_delta_integral(p: &Params, dx: f64, rho_c: f64, rho_g: f64) -> f64 {
                 }
             }
             let g = g / vol_c;
-            if g.abs() > 0.1 * p.kernel[1] as f64 {
+            if g.abs() > 0.1 * p.kernel.inv_h as f64 {
                 g.abs() * dx
             } else {
                 0.0
@@ -403,43 +605,39 @@ pub fn gas_delta_integral(p: &Params, dx: f64, rho_c: f64, rho_g: f64) -> f64 {
         .sum()
 }
 
-/// The laser part of the block; every other field zero (filled by `Params::new`).
-fn laser_block(m: &Model) -> Params {
-    let mut p = Params::zeroed();
+/// The laser part of the block (all zero without a laser).
+fn laser_block(m: &Model) -> Laser {
+    let mut p = Laser::zeroed();
     let Some(l) = &m.laser else { return p };
     let d = m.dim as i32;
     let dx = m.dx;
-    let model = match l.model {
+    p.model = match l.model {
         crate::scene::LaserModel::BeerLambert => LASER_BEER_LAMBERT,
         crate::scene::LaserModel::GaussianSurface => LASER_SURFACE,
     };
-    p.laser = [
-        l.absorptivity as f32,
-        l.radius as f32,
-        l.absorption as f32,
-        model,
-    ];
+    p.absorptivity = l.absorptivity as f32;
+    p.radius = l.radius as f32;
+    p.absorption = l.absorption as f32;
     let peak = if m.dim == 3 {
         2.0 / (PI * l.radius * l.radius)
     } else {
         (2.0 / PI).sqrt() / l.radius
     };
-    p.laser_grid = [
-        dx as f32,
-        peak as f32,
-        dx.powi(d) as f32,
-        dx.powi(d - 1) as f32,
-    ];
-    let mut bins = [1u32; 4];
+    p.bin_size = dx as f32;
+    p.peak_per_watt = peak as f32;
+    p.bin_volume = dx.powi(d) as f32;
+    p.column_area = dx.powi(d - 1) as f32;
+    let mut bins = [1u32, 1, 1, 0];
     for a in 0..m.dim as usize {
         bins[a] = ((m.domain_hi[a] - m.domain_lo[a]) / dx - 1e-9)
             .ceil()
             .max(1.0) as u32;
     }
-    bins[3] = l.path.len() as u32 + 256 * l.power.len() as u32;
-    p.laser_bins = bins;
+    p.bins = bins;
+    p.path_points = l.path.len() as u32;
+    p.power_steps = l.power.len() as u32;
     let lo = m.to_local(m.domain_lo);
-    p.laser_lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
+    p.lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
     for (k, (t, x)) in l.path.iter().enumerate() {
         let mut abs = m.domain_lo;
         abs[0] = x[0];
@@ -447,15 +645,20 @@ fn laser_block(m: &Model) -> Params {
             abs[1] = x[1];
         }
         let loc = m.to_local(abs);
-        p.laser_path[k] = [
-            *t as f32,
-            loc[0] as f32,
-            if m.dim == 3 { loc[1] as f32 } else { 0.0 },
-            0.0,
-        ];
+        p.path[k] = PathPoint {
+            time: *t as f32,
+            x: loc[0] as f32,
+            y: if m.dim == 3 { loc[1] as f32 } else { 0.0 },
+            pad0: 0.0,
+        };
     }
     for (k, (t, pw)) in l.power.iter().enumerate() {
-        p.laser_power[k] = [*t as f32, *pw as f32, 0.0, 0.0];
+        p.power[k] = PowerStep {
+            time: *t as f32,
+            power: *pw as f32,
+            pad0: 0.0,
+            pad1: 0.0,
+        };
     }
     p
 }
@@ -471,64 +674,74 @@ fn finite_or_max(v: f64) -> f32 {
 /// Stefan–Boltzmann constant (W m⁻² K⁻⁴).
 const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
 
-fn loss_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
-    let mut e = [[0.0f32; 4]; MAX_PHASES];
-    let mut f = [[0.0f32; 4]; MAX_PHASES];
-    for (i, ph) in m.phases.iter().enumerate() {
-        let Some(t) = ph.thermal else { continue };
-        if let Some(v) = t.evaporation {
-            e[i] = [
-                v.pressure_constant as f32,
-                v.temperature_constant as f32,
-                (1.0 / v.boiling_temperature) as f32,
-                v.latent_heat as f32,
-            ];
-            f[i][0] = v.enthalpy_reference as f32;
-            f[i][1] = v.vapor_constant as f32;
-            f[i][2] = (0.82 * v.sticking) as f32;
-        }
-        f[i][3] = (t.emissivity * STEFAN_BOLTZMANN) as f32;
+/// One phase's row: flow material, wall motion, heat, melting and surface losses.
+fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
+    let mut b = Phase::zeroed();
+    b.rho0 = ph.rho0 as f32;
+    b.c2 = (ph.sound_speed * ph.sound_speed) as f32;
+    b.eta = ph.viscosity as f32;
+    b.kind = match ph.kind {
+        PhaseKind::Liquid => KIND_LIQUID,
+        PhaseKind::Gas => KIND_GAS,
+        PhaseKind::Wall => KIND_WALL,
+        PhaseKind::Solid => KIND_SOLID,
+    };
+    b.velocity = [
+        ph.velocity[0] as f32,
+        ph.velocity[1] as f32,
+        ph.velocity[2] as f32,
+        0.0,
+    ];
+    if ph.slip == Slip::FreeSlip {
+        b.flags |= PHASE_FREE_SLIP;
     }
-    (e, f)
-}
-
-fn heat_tables(m: &Model) -> ([[f32; 4]; MAX_PHASES], [[f32; 4]; MAX_PHASES]) {
-    let mut c = [[0.0f32; 4]; MAX_PHASES];
-    let mut d = [[0.0f32; 4]; MAX_PHASES];
-    for (i, ph) in m.phases.iter().enumerate() {
-        let Some(t) = ph.thermal else { continue };
-        let mut flags = 0;
-        if ph.kind == PhaseKind::Wall {
-            flags |= HEAT_DIRICHLET;
-        }
-        if ph.is_fluid() {
-            flags |= HEAT_LIQUID;
-        }
-        let (ts, tl, l) = match (ph.kind, t.melting) {
-            (PhaseKind::Wall, _) => (t.temperature, 0.0, 0.0),
-            (_, Some(m)) => m,
-            (_, None) => (0.0, 0.0, 0.0),
-        };
-        if t.melting.is_some() {
-            flags |= HEAT_MELTS;
-        }
-        if let Some(target) = ph.switch_to {
-            flags |= (target as u32 + 1) << HEAT_SWITCH_SHIFT;
-        }
-        let cp = t.heat_capacity;
-        let (band, b) = match t.melting {
-            Some(_) => (t.enthalpy(tl) - t.enthalpy(ts), cp + l / (tl - ts)),
-            None => (0.0, 0.0),
-        };
-        c[i] = [
-            t.conductivity as f32,
-            cp as f32,
-            t.reference_temperature() as f32,
-            band as f32,
-        ];
-        d[i] = [ts as f32, tl as f32, b as f32, flags as f32];
+    if ph.moves {
+        b.flags |= PHASE_MOVES;
     }
-    (c, d)
+    let Some(t) = ph.thermal else { return b };
+    if ph.kind == PhaseKind::Wall {
+        b.flags |= HEAT_DIRICHLET;
+        b.fixed_temperature = t.temperature as f32;
+    }
+    if ph.is_fluid() {
+        b.flags |= HEAT_LIQUID;
+    }
+    if t.melting.is_some() {
+        b.flags |= HEAT_MELTS;
+    }
+    if let Some(target) = ph.switch_to {
+        b.flags |= (target as u32 + 1) << HEAT_SWITCH_SHIFT;
+    }
+    let cp = t.heat_capacity;
+    b.conductivity = t.conductivity as f32;
+    b.heat_capacity = cp as f32;
+    b.reference_temperature = t.reference_temperature() as f32;
+    if let Some((ts, tl, l)) = t.melting {
+        b.band_enthalpy = (t.enthalpy(tl) - t.enthalpy(ts)) as f32;
+        b.solidus = ts as f32;
+        b.liquidus = tl as f32;
+        b.band_capacity = (cp + l / (tl - ts)) as f32;
+    }
+    if ph.kind == PhaseKind::Liquid {
+        b.mushy_damping = t.mushy_damping as f32;
+    }
+    let (kl, cl) = t.liquid;
+    b.liquid_conductivity = kl as f32;
+    b.liquid_heat_capacity = cl as f32;
+    b.capacity_slope = t.melting.map_or(0.0, |(ts, tl, _)| {
+        (cl - t.heat_capacity) / (2.0 * (tl - ts))
+    }) as f32;
+    if let Some(v) = t.evaporation {
+        b.evap_pressure = v.pressure_constant as f32;
+        b.evap_temperature = v.temperature_constant as f32;
+        b.inv_boiling_temperature = (1.0 / v.boiling_temperature) as f32;
+        b.evap_latent_heat = v.latent_heat as f32;
+        b.evap_enthalpy_reference = v.enthalpy_reference as f32;
+        b.vapor_constant = v.vapor_constant as f32;
+        b.recondensation = (0.82 * v.sticking) as f32;
+    }
+    b.emissivity_sb = (t.emissivity * STEFAN_BOLTZMANN) as f32;
+    b
 }
 
 #[cfg(test)]

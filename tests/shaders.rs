@@ -2,7 +2,8 @@
 //! shader then fails here with its line and message instead of as a pipeline error
 //! at run time.
 
-use spatter::backend::gpu::{shader_sources, ENTRY_POINTS};
+use spatter::backend::entry_points;
+use spatter::backend::gpu::shader_sources;
 
 #[test]
 fn every_shader_validates() {
@@ -18,10 +19,10 @@ fn every_shader_validates() {
         .validate(&module)
         .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&source)));
         // Every pipeline the backend builds from this file finds its entry point.
-        for (pipeline, _, entry) in ENTRY_POINTS.iter().filter(|e| e.1 == name) {
+        for (entry, _) in entry_points().into_iter().filter(|e| e.1 == name) {
             assert!(
                 module.entry_points.iter().any(|ep| ep.name == *entry),
-                "pipeline {pipeline}: no entry point {entry} in {name}.wgsl"
+                "pass table: no entry point {entry} in {name}.wgsl"
             );
         }
     }

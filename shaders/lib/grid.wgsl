@@ -11,21 +11,21 @@ fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 fn cell_coord(p: vec4<f32>) -> vec3<i32> {
     var c: vec3<i32>;
     for (var a = 0u; a < 3u; a++) {
-        let f = floor(p[a] * P.cell_inv[a]);
-        c[a] = clamp(i32(f), 0, i32(P.grid[a]) - 1);
+        let f = floor(p[a] * P.grid.cell_inv[a]);
+        c[a] = clamp(i32(f), 0, i32(P.grid.cells[a]) - 1);
     }
     return c;
 }
 
 fn cell_index(c: vec3<i32>) -> u32 {
-    return u32(c.x) + P.grid.x * (u32(c.y) + P.grid.y * u32(c.z));
+    return u32(c.x) + P.grid.cells.x * (u32(c.y) + P.grid.cells.y * u32(c.z));
 }
 
 // Cell coordinate c on axis a, wrapped on periodic axes; -1 when outside the grid.
 fn wrap_cell(c: i32, a: u32) -> i32 {
-    let n = i32(P.grid[a]);
+    let n = i32(P.grid.cells[a]);
     if (c >= 0 && c < n) { return c; }
-    if ((P.grid.w & (1u << a)) != 0u) { return (c + n) % n; }
+    if ((P.sizes.flags & (1u << a)) != 0u) { return (c + n) % n; }
     return -1;
 }
 
@@ -35,7 +35,7 @@ fn neighbor_cell_index(ci: vec3<i32>, off: vec3<i32>) -> i32 {
     let cy = wrap_cell(ci.y + off.y, 1u);
     let cz = wrap_cell(ci.z + off.z, 2u);
     if (cx < 0 || cy < 0 || cz < 0) { return -1; }
-    return cx + i32(P.grid.x) * (cy + i32(P.grid.y) * cz);
+    return cx + i32(P.grid.cells.x) * (cy + i32(P.grid.cells.y) * cz);
 }
 
 // Start and end of the sorted particles in neighbour cell ci + off (empty if outside).
@@ -52,18 +52,18 @@ fn neighbor_cell(ci: vec3<i32>, off: vec3<i32>) -> vec2<u32> {
 // cell walk of the CPU twin (so sums stay bit-identical), with one loop instead of
 // three. A periodic x axis can wrap a cell out of the run: then one segment per cell.
 fn row_segments() -> u32 {
-    if ((P.grid.w & 1u) != 0u) { return 3u; }
+    if ((P.sizes.flags & 1u) != 0u) { return 3u; }
     return 1u;
 }
 
 fn row_segment(ci: vec3<i32>, dy: i32, dz: i32, seg: u32) -> vec2<u32> {
-    if ((P.grid.w & 1u) != 0u) {
+    if ((P.sizes.flags & 1u) != 0u) {
         return neighbor_cell(ci, vec3<i32>(i32(seg) - 1, dy, dz));
     }
     let c = neighbor_cell_index(ci, vec3<i32>(0, dy, dz));
     if (c < 0) { return vec2<u32>(0u, 0u); }
     let first = u32(c) - select(0u, 1u, ci.x > 0);
-    let last = u32(c) + select(0u, 1u, ci.x + 1 < i32(P.grid.x));
+    let last = u32(c) + select(0u, 1u, ci.x + 1 < i32(P.grid.cells.x));
     // From the first non-empty cell's start to the last non-empty cell's end.
     var run = vec2<u32>(0u, 0u);
     var found = false;
@@ -85,11 +85,11 @@ fn row_segment(ci: vec3<i32>, dy: i32, dz: i32, seg: u32) -> vec2<u32> {
 fn min_image(pi: vec4<f32>, pj: vec4<f32>) -> vec3<f32> {
     var d = vec3<f32>(pi.x - pj.x, pi.y - pj.y, pi.z - pj.z);
     for (var a = 0u; a < 3u; a++) {
-        if ((P.grid.w & (1u << a)) != 0u) {
-            if (d[a] > P.half_period[a]) {
-                d[a] = d[a] - P.period[a];
-            } else if (d[a] < -P.half_period[a]) {
-                d[a] = d[a] + P.period[a];
+        if ((P.sizes.flags & (1u << a)) != 0u) {
+            if (d[a] > P.grid.half_period[a]) {
+                d[a] = d[a] - P.grid.period[a];
+            } else if (d[a] < -P.grid.half_period[a]) {
+                d[a] = d[a] + P.grid.period[a];
             }
         }
     }
@@ -102,5 +102,5 @@ fn len2(d: vec3<f32>) -> f32 {
 
 // Neighbour cells are visited dz, dy, dx from -1 to 1; in 2D only dz = 0.
 fn z_range() -> i32 {
-    return select(0, 1, P.counts.z == 3u);
+    return select(0, 1, P.sizes.dim == 3u);
 }

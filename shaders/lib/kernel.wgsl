@@ -5,9 +5,9 @@ fn p4(t: f32) -> f32 { return t * t * t * t; }
 fn p5(t: f32) -> f32 { return t * t * t * t * t; }
 
 fn kernel_w(r: f32) -> f32 {
-    let sigma = P.kern.z;
-    let q = r * P.kern.y;
-    switch P.counts.w {
+    let sigma = P.kernel.sigma;
+    let q = r * P.kernel.inv_h;
+    switch P.kernel.kind {
         case 0u: {
             let t1 = max(c_one() - q, 0.0);
             let t2 = max(c_two() - q, 0.0);
@@ -33,9 +33,9 @@ fn kernel_w(r: f32) -> f32 {
 // Negated literals are written as the exact negation of a product, so the operation
 // order matches the Rust twin's `-5.0 * x`.
 fn kernel_dw(r: f32) -> f32 {
-    let sigma_h = P.kern.z * P.kern.y;
-    let q = r * P.kern.y;
-    switch P.counts.w {
+    let sigma_h = P.kernel.sigma * P.kernel.inv_h;
+    let q = r * P.kernel.inv_h;
+    switch P.kernel.kind {
         case 0u: {
             let t1 = max(c_one() - q, 0.0);
             let t2 = max(c_two() - q, 0.0);

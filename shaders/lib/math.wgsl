@@ -7,15 +7,15 @@ fn pm_exp(x: f32) -> f32 {
     if (x != x) { return x; }
     if (x > 88.0) { return bitcast<f32>(0x7f800000u); }
     if (x < -87.3) { return 0.0; }
-    let log2e = P.consts[3].y;
-    let ln2_hi = P.consts[3].z;
-    let ln2_lo = P.consts[3].w;
-    let c0 = P.consts[4].x;
-    let c1 = P.consts[4].y;
-    let c2 = P.consts[4].z;
-    let c3 = P.consts[4].w;
-    let c4 = P.consts[5].x;
-    let c5 = P.consts[5].y;
+    let log2e = P.consts.log2e;
+    let ln2_hi = P.consts.ln2_hi;
+    let ln2_lo = P.consts.ln2_lo;
+    let c0 = P.consts.exp_c0;
+    let c1 = P.consts.exp_c1;
+    let c2 = P.consts.exp_c2;
+    let c3 = P.consts.exp_c3;
+    let c4 = P.consts.exp_c4;
+    let c5 = P.consts.exp_c5;
     let one = c_one();
     let n = floor(x * log2e + c0);
     let r = (x - n * ln2_hi) - n * ln2_lo;
@@ -40,15 +40,15 @@ fn pm_ln(x: f32) -> f32 {
     let f = m - c_one();
     let s = f / (c_two() + f);
     let z = s * s;
-    let l0 = P.consts[5].z;
-    let l1 = P.consts[5].w;
-    let l2 = P.consts[6].x;
-    let l3 = P.consts[6].y;
-    let l4 = P.consts[6].z;
+    let l0 = P.consts.ln_c0;
+    let l1 = P.consts.ln_c1;
+    let l2 = P.consts.ln_c2;
+    let l3 = P.consts.ln_c3;
+    let l4 = P.consts.ln_c4;
     let poly = c_one() + z * (l0 + z * (l1 + z * (l2 + z * (l3 + z * l4))));
     let lnm = (s + s) * poly;
     let ef = f32(e);
-    return ef * P.consts[3].z + (ef * P.consts[3].w + lnm);
+    return ef * P.consts.ln2_hi + (ef * P.consts.ln2_lo + lnm);
 }
 
 fn pm_pow(x: f32, y: f32) -> f32 {

@@ -1,33 +1,166 @@
-// The parameter block and the Sim block (twin of src/params.rs, src/state.rs).
-// Bit-match rules (DESIGN.md): same operation order as the Rust twin, no fma, no
-// built-in transcendentals, explicit x*x+y*y+z*z.
+// The parameter block and the Sim block: twins of src/params.rs and src/state.rs,
+// member for member (tests/params_layout.rs compares the two layouts through
+// naga). Bit-match rules (DESIGN.md): same operation order as the Rust twin, no
+// fma, no built-in transcendentals, explicit x*x+y*y+z*z.
+
+struct Sizes {
+    n_particles: u32,
+    n_cells: u32,
+    dim: u32,
+    flags: u32,              // FLAG_* bits
+}
+
+struct Grid {
+    cells: vec4<u32>,        // cells along x, y, z
+    cell_inv: vec4<f32>,     // 1 / cell size per axis
+    period: vec4<f32>,       // period length per axis (0 where not periodic)
+    half_period: vec4<f32>,
+}
+
+struct Kernel {
+    kind: u32,               // 0 quintic, 1 Wendland C2, 2 cubic spline
+    h: f32,
+    inv_h: f32,
+    sigma: f32,              // normalisation
+    support2: f32,           // support radius squared
+    eta2: f32,               // 0.01 h², regularises 1/r² terms
+    pad0: f32,
+    pad1: f32,
+}
+
+struct TimeStep {
+    max_sound_speed: f32,
+    viscous_limit: f32,      // 0.125 h²/nu
+    conduction_limit: f32,   // 0.1 rho c_p h²/k
+    fixed_dt: f32,           // 0: adaptive
+}
+
+struct Flow {
+    gravity: vec4<f32>,
+    background_pressure: f32,
+    interface_viscosity: f32, // F22 (32) alpha_0^lg (0 = off)
+    wall_weight_floor: f32,   // wall pass: Shepard weight floor
+    pad0: f32,
+}
+
+struct Surfaces {
+    inv_kappa: f32,          // 1 / kappa, the surface delta's normalisation
+    ambient_t4: f32,         // T_ambient^4 for radiation
+    pad0: f32,
+    pad1: f32,
+}
+
+struct PathPoint {
+    time: f32,
+    x: f32,                  // lateral beam centre (grid-relative)
+    y: f32,
+    pad0: f32,
+}
+
+struct PowerStep {
+    time: f32,
+    power: f32,              // from `time` on
+    pad0: f32,
+    pad1: f32,
+}
+
+struct Laser {
+    absorptivity: f32,
+    radius: f32,
+    absorption: f32,         // Beer-Lambert absorption coefficient
+    model: u32,              // 0 none, LASER_BEER_LAMBERT, LASER_SURFACE
+    bin_size: f32,
+    peak_per_watt: f32,      // peak irradiance per watt
+    bin_volume: f32,
+    column_area: f32,
+    bins: vec4<u32>,         // bins per axis
+    lo: vec4<f32>,           // bin grid lower corner (grid-relative)
+    path_points: u32,
+    power_steps: u32,
+    pad0: u32,
+    pad1: u32,
+    path: array<PathPoint, 8>,
+    power: array<PowerStep, 8>,
+}
+
+struct Phase {
+    rho0: f32,
+    c2: f32,                 // sound speed squared
+    eta: f32,                // dynamic viscosity
+    kind: u32,               // KIND_*
+    velocity: vec4<f32>,     // wall velocity
+    conductivity: f32,       // solid k_s
+    heat_capacity: f32,      // solid c_s
+    reference_temperature: f32,
+    band_enthalpy: f32,      // h(T_l) - h(T_s)
+    solidus: f32,
+    liquidus: f32,
+    band_capacity: f32,      // b = c_s + L / (T_l - T_s)
+    flags: u32,              // HEAT_*, PHASE_* bits
+    mushy_damping: f32,      // C (1/s)
+    liquid_conductivity: f32,
+    liquid_heat_capacity: f32,
+    capacity_slope: f32,     // a = (c_l - c_s) / (2 (T_l - T_s))
+    evap_pressure: f32,      // C_p
+    evap_temperature: f32,   // C_T
+    inv_boiling_temperature: f32,
+    evap_latent_heat: f32,   // h_v
+    evap_enthalpy_reference: f32, // T_h0
+    vapor_constant: f32,     // C_M
+    recondensation: f32,     // 0.82 c_s
+    emissivity_sb: f32,      // emissivity * sigma_B
+    fixed_temperature: f32,  // a Dirichlet wall's temperature
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+}
+
+// Arithmetic literals (see consts.wgsl).
+struct Consts {
+    half: f32,
+    quarter: f32,
+    two: f32,
+    one: f32,
+    three: f32,
+    six: f32,
+    fifteen: f32,
+    five: f32,
+    thirty: f32,
+    seventy_five: f32,
+    one_and_half: f32,
+    three_quarters: f32,
+    nine_quarters: f32,
+    log2e: f32,
+    ln2_hi: f32,
+    ln2_lo: f32,
+    exp_c0: f32,
+    exp_c1: f32,
+    exp_c2: f32,
+    exp_c3: f32,
+    exp_c4: f32,
+    exp_c5: f32,
+    ln_c0: f32,
+    ln_c1: f32,
+    ln_c2: f32,
+    ln_c3: f32,
+    ln_c4: f32,
+    four: f32,
+    tenth: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+}
 
 struct Params {
-    counts: vec4<u32>,       // n, n_cells, dim, kernel
-    grid: vec4<u32>,         // nx, ny, nz, flags
-    cell_inv: vec4<f32>,
-    period: vec4<f32>,
-    half_period: vec4<f32>,
-    kern: vec4<f32>,         // h, 1/h, sigma, support²
-    gravity: vec4<f32>,      // g, background pressure
-    dtp: vec4<f32>,          // h, c_max, viscous limit, fixed dt
-    phase_a: array<vec4<f32>, 8>, // rho0, c², eta, kind
-    phase_b: array<vec4<f32>, 8>, // wall velocity, slip
-    phase_c: array<vec4<f32>, 8>, // heat: k, c_p, h_solidus, h_liquidus
-    phase_d: array<vec4<f32>, 8>, // heat: T_solidus, T_liquidus, L, flags
-    phase_e: array<vec4<f32>, 8>, // evaporation: C_p, C_T, 1/T_v, h_v
-    phase_f: array<vec4<f32>, 8>, // T_h0, C_M, 0.82 c_s, emissivity * sigma_B
-    phase_g: array<vec4<f32>, 8>, // mushy-zone sink C (1/s), unused
-    heat: vec4<f32>,              // conduction dt limit, eta², heat scene (1/0), unused
-    laser: vec4<f32>,             // absorptivity, beam radius, absorption coefficient, model
-    iface: vec4<f32>,             // interface pass: 1/kappa, T_ambient^4, F22 gas mode (1/0), alpha_0^lg
-    laser_grid: vec4<f32>,        // bin size, peak irradiance per watt, bin volume, column area
-    laser_bins: vec4<u32>,        // bins per axis, path points + 256 * power steps
-    laser_lo: vec4<f32>,          // bin grid lower corner (grid-relative)
-    laser_path: array<vec4<f32>, 8>,  // time, lateral beam centre
-    laser_power: array<vec4<f32>, 8>, // time, power from then on
-    consts: array<vec4<f32>, 8>,  // arithmetic literals, see c_* below
-    wall: vec4<f32>,              // wall pass: Shepard weight floor; moving wall phases (bit mask)
+    sizes: Sizes,
+    grid: Grid,
+    kernel: Kernel,
+    time_step: TimeStep,
+    flow: Flow,
+    surfaces: Surfaces,
+    laser: Laser,
+    phases: array<Phase, 8>,
+    consts: Consts,
 }
 
 struct Sim {
@@ -43,9 +176,19 @@ struct Sim {
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
 const FLAG_VISCOUS_HEATING: u32 = 16u;
-const KIND_WALL: f32 = 2.0;
-const KIND_SOLID: f32 = 3.0;
+const FLAG_HEAT: u32 = 32u;
+const FLAG_INTERFACE: u32 = 64u;
+const FLAG_GAS_INTERFACE: u32 = 128u;
+const KIND_LIQUID: u32 = 0u;
+const KIND_GAS: u32 = 1u;
+const KIND_WALL: u32 = 2u;
+const KIND_SOLID: u32 = 3u;
 const HEAT_DIRICHLET: u32 = 1u;
 const HEAT_MELTS: u32 = 2u;
 const HEAT_LIQUID: u32 = 4u;
+const HEAT_SWITCH_SHIFT: u32 = 8u;
+const PHASE_FREE_SLIP: u32 = 4096u;
+const PHASE_MOVES: u32 = 8192u;
+const LASER_BEER_LAMBERT: u32 = 1u;
+const LASER_SURFACE: u32 = 2u;
 const WG: u32 = 64u;

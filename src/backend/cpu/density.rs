@@ -42,9 +42,9 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborLis
 
 #[inline(always)]
 pub fn equation_of_state(pr: &Params, phase: u32, rho: f32) -> f32 {
-    let m = pr.phase_a[phase as usize];
-    let p = m[1] * (rho - m[0]);
-    if pr.grid[3] & FLAG_PRESSURE_FLOOR != 0 {
+    let m = pr.phase(phase);
+    let p = m.c2 * (rho - m.rho0);
+    if pr.flag(FLAG_PRESSURE_FLOOR) {
         p.max(0.0)
     } else {
         p

@@ -22,7 +22,7 @@
 use super::neighbors::{for_each_listed, CellTable, NeighborList};
 use crate::kernel;
 use crate::model::MAX_PHASES;
-use crate::params::{Params, FLAG_VISCOUS_HEATING};
+use crate::params::{Params, FLAG_VISCOUS_HEATING, KIND_WALL, PHASE_FREE_SLIP};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -33,7 +33,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     // compute per pair from the same operands: the same bits, fewer divisions.
     let eta_pair = PairViscosity::new(pr);
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
-    let background = pr.gravity[3] != 0.0;
+    let background = pr.flow.background_pressure != 0.0;
     st.acc
         .par_iter_mut()
         .zip(st.acc_b.par_iter_mut())
@@ -43,16 +43,16 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
             if pr.is_wall(ph_i) {
                 return;
             }
-            let mat_i = pr.phase_a[ph_i as usize];
+            let mat_i = pr.phase(ph_i);
             let (rho_i, p_i, m_i) = (rho[i], p[i], mass[i]);
             let v_i = vel[i];
             let vol_i = vol[i];
-            let pb = pr.gravity[3];
+            let pb = pr.flow.background_pressure;
             let mut f = [0.0f32; 3];
             let mut fb = [0.0f32; 3];
             let mut heating = 0.0f32;
-            let viscous_heating = pr.grid[3] & FLAG_VISCOUS_HEATING != 0;
-            let (h, alpha0) = (pr.kernel[0], pr.interface[3]);
+            let viscous_heating = pr.flag(FLAG_VISCOUS_HEATING);
+            let (h, alpha0) = (pr.kernel.h, pr.flow.interface_viscosity);
             let alpha_i = if alpha0 > 0.0 {
                 alpha0 * (h * surface[i][3]).min(1.0)
             } else {
@@ -65,11 +65,11 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
                 let r = r2.sqrt();
                 let dwdr = kernel::dw(pr, r);
                 let ph_j = phase[j];
-                let mat_j = pr.phase_a[ph_j as usize];
-                let wall = mat_j[3] >= crate::params::KIND_WALL;
+                let mat_j = pr.phase(ph_j);
+                let wall = mat_j.kind >= KIND_WALL;
                 let p_j = p[j];
                 let (rho_j, m_j, vol_j) = if wall {
-                    let rho_j = mat_i[0] + p_j / mat_i[1];
+                    let rho_j = mat_i.rho0 + p_j / mat_i.c2;
                     (rho_j, m_i, m_i / rho_j)
                 } else {
                     (rho[j], mass[j], vol[j])
@@ -96,7 +96,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
                     let pair = Pair {
                         m: [m_i, m_j],
                         rho: [rho_i, rho_j],
-                        c2: [mat_i[1], mat_j[1]],
+                        c2: [mat_i.c2, mat_j.c2],
                         u: [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]],
                     };
                     let s = interface_viscosity(pr, &pair, d, r2, dwdr, alpha);
@@ -109,7 +109,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
                     // F·(u_i − u_j); against a wall it is F·(u_i − U_wall) with the
                     // wall's real velocity (the mirrored one is a ghost).
                     let (w, share) = if wall {
-                        (pr.phase_b[ph_j as usize], 1.0)
+                        (mat_j.velocity, 1.0)
                     } else {
                         (v_j, 0.5)
                     };
@@ -119,7 +119,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
                     heating -= share * vv * fv * uw;
                 }
             });
-            let g = pr.gravity;
+            let g = pr.flow.gravity;
             *acc = [
                 f[0] / m_i + g[0],
                 f[1] / m_i + g[1],
@@ -138,11 +138,11 @@ impl PairViscosity {
     fn new(pr: &Params) -> Self {
         let mut t = [[0.0f32; MAX_PHASES]; MAX_PHASES];
         for (i, row) in t.iter_mut().enumerate() {
-            let eta_i = pr.phase_a[i][2];
+            let eta_i = pr.phases[i].eta;
             for (j, eta) in row.iter_mut().enumerate() {
-                let wall = pr.phase_a[j][3] >= crate::params::KIND_WALL;
-                let slip = wall && pr.phase_b[j][3] != 0.0;
-                let eta_j = if wall { eta_i } else { pr.phase_a[j][2] };
+                let wall = pr.phases[j].kind >= KIND_WALL;
+                let slip = wall && pr.phases[j].flags & PHASE_FREE_SLIP != 0;
+                let eta_j = if wall { eta_i } else { pr.phases[j].eta };
                 let eta_sum = eta_i + eta_j;
                 *eta = if eta_sum > 0.0 && !slip {
                     2.0 * eta_i * eta_j / eta_sum
@@ -174,5 +174,5 @@ fn interface_viscosity(pr: &Params, q: &Pair, d: [f32; 3], r2: f32, dwdr: f32, a
     let rho = (q.rho[0] + q.rho[1]) * 0.5;
     let ur = q.u[0] * d[0] + q.u[1] * d[1] + q.u[2] * d[2];
     let r = r2.sqrt();
-    q.m[0] * q.m[1] * alpha * pr.kernel[0] * c / rho * ur / (r2 + pr.heat[1]) * dwdr / r
+    q.m[0] * q.m[1] * alpha * pr.kernel.h * c / rho * ur / (r2 + pr.kernel.eta2) * dwdr / r
 }

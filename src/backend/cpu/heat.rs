@@ -22,7 +22,7 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID};
+use crate::params::{Params, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID};
 use crate::portable_math::exp as pm_exp;
 use crate::state::State;
 use rayon::prelude::*;
@@ -32,7 +32,7 @@ use rayon::prelude::*;
 #[inline(always)]
 fn heat_density(pr: &Params, rho: &[f32], phase: u32, i: usize) -> f32 {
     if pr.is_wall(phase) {
-        pr.phase_a[phase as usize][0]
+        pr.phases[phase as usize].rho0
     } else {
         rho[i]
     }
@@ -56,7 +56,7 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
                 sw += wk;
                 st_ += heat_in[j][1] * wk;
             });
-            let t_wall = pr.phase_d[ph as usize][0];
+            let t_wall = pr.phases[ph as usize].fixed_temperature;
             Some(if sw > 0.0 {
                 2.0 * t_wall - st_ / sw
             } else {
@@ -74,11 +74,11 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
 pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     wall_temperature(pr, st, grid);
     let dt = st.sim.dt;
-    let eta2 = pr.heat[1];
+    let eta2 = pr.kernel.eta2;
     // The laser pass left its source (W/kg) in heat.w.
-    let laser_on = pr.laser[3] != 0.0;
-    let surface_on = pr.heat[3] != 0.0;
-    let viscous_heating = pr.grid[3] & crate::params::FLAG_VISCOUS_HEATING != 0;
+    let laser_on = pr.laser.model != 0;
+    let surface_on = pr.flag(FLAG_INTERFACE);
+    let viscous_heating = pr.flag(crate::params::FLAG_VISCOUS_HEATING);
     let acc = &st.acc;
     let surf = &st.surface;
     let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
@@ -141,18 +141,19 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
 /// both per unit area, times the surface delta δ and divided by ρ0.
 #[inline(always)]
 pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
-    let e = pr.phase_e[phase as usize];
-    let f = pr.phase_f[phase as usize];
+    let m = pr.phase(phase);
     let mut flux = 0.0f32;
-    if e[0] > 0.0 {
-        let pv = e[0] * pm_exp(-(e[1] * (1.0 / t - e[2])));
-        let mdot = f[2] * pv * (f[1] / t).sqrt();
-        flux += mdot * (e[3] + pr.phase_g[phase as usize][2] * (t - f[0]));
+    if m.evap_pressure > 0.0 {
+        let pv =
+            m.evap_pressure * pm_exp(-(m.evap_temperature * (1.0 / t - m.inv_boiling_temperature)));
+        let mdot = m.recondensation * pv * (m.vapor_constant / t).sqrt();
+        flux +=
+            mdot * (m.evap_latent_heat + m.liquid_heat_capacity * (t - m.evap_enthalpy_reference));
     }
-    if f[3] > 0.0 {
-        flux += f[3] * (t * t * t * t - pr.interface[1]);
+    if m.emissivity_sb > 0.0 {
+        flux += m.emissivity_sb * (t * t * t * t - pr.surfaces.ambient_t4);
     }
-    flux * delta / pr.phase_a[phase as usize][0]
+    flux * delta / m.rho0
 }
 
 /// Temperature and liquid fraction of the stored enthalpy h = h(T) − h(T_ref) for
@@ -162,29 +163,31 @@ pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
 /// cancellation); above it T = T_l + (h − h_band)/c_l.
 #[inline(always)]
 pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
-    let c = pr.phase_c[phase as usize];
-    let d = pr.phase_d[phase as usize];
-    let g = pr.phase_g[phase as usize];
-    let flags = pr.heat_flags(phase);
+    let m = pr.phase(phase);
+    let flags = m.flags;
     if flags & HEAT_MELTS == 0 {
         let fl = if flags & HEAT_LIQUID != 0 { 1.0 } else { 0.0 };
-        return (c[2] + h / c[1], fl);
+        return (m.reference_temperature + h / m.heat_capacity, fl);
     }
     if h <= 0.0 {
-        (d[0] + h / c[1], 0.0)
-    } else if h >= c[3] {
-        (d[1] + (h - c[3]) / g[2], 1.0)
+        (m.solidus + h / m.heat_capacity, 0.0)
+    } else if h >= m.band_enthalpy {
+        (
+            m.liquidus + (h - m.band_enthalpy) / m.liquid_heat_capacity,
+            1.0,
+        )
     } else {
-        let x = 2.0 * h / (d[2] + (d[2] * d[2] + 4.0 * g[3] * h).sqrt());
-        (d[0] + x, x / (d[1] - d[0]))
+        let b = m.band_capacity;
+        let x = 2.0 * h / (b + (b * b + 4.0 * m.capacity_slope * h).sqrt());
+        (m.solidus + x, x / (m.liquidus - m.solidus))
     }
 }
 
 /// Conductivity at liquid fraction f_l: solid's plus f_l times the liquid's excess.
 #[inline(always)]
 pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
-    let ks = pr.phase_c[phase as usize][0];
-    ks + fl * (pr.phase_g[phase as usize][1] - ks)
+    let ks = pr.phases[phase as usize].conductivity;
+    ks + fl * (pr.phases[phase as usize].liquid_conductivity - ks)
 }
 
 /// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a
@@ -216,7 +219,7 @@ pub fn temperature(pr: &Params, st: &mut State) {
             let Some(target) = pr.switch_target(*ph) else {
                 return;
             };
-            let solid = pr.phase_a[*ph as usize][3] == KIND_SOLID;
+            let solid = pr.phases[*ph as usize].kind == KIND_SOLID;
             if solid && fl >= 0.5 {
                 *ph = target;
             } else if !solid && fl < 0.5 {

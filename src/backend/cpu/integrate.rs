@@ -22,7 +22,7 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
             let ph = phase[i];
             if pr.is_wall(ph) {
                 if pr.wall_moves(ph) {
-                    let w = pr.phase_b[ph as usize];
+                    let w = pr.phase(ph).velocity;
                     for c in 0..3 {
                         x[c] += dt * w[c];
                         wrap_periodic(pr, x, c);
@@ -43,11 +43,11 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
 /// Brings coordinate `c` back into [0, period) on a periodic axis.
 #[inline(always)]
 fn wrap_periodic(pr: &Params, x: &mut [f32; 4], c: usize) {
-    if pr.grid[3] & (1 << c) != 0 {
-        if x[c] >= pr.period[c] {
-            x[c] -= pr.period[c];
+    if pr.sizes.flags & (1 << c) != 0 {
+        if x[c] >= pr.grid.period[c] {
+            x[c] -= pr.grid.period[c];
         } else if x[c] < 0.0 {
-            x[c] += pr.period[c];
+            x[c] += pr.grid.period[c];
         }
     }
 }
@@ -67,7 +67,7 @@ pub fn kick(pr: &Params, st: &mut State) {
         for c in 0..3 {
             v[c] += hdt * a[c];
         }
-        let sink = pr.phase_g[phase[i] as usize][0];
+        let sink = pr.phases[phase[i] as usize].mushy_damping;
         if sink > 0.0 {
             let damp = 1.0 + dt * sink * (1.0 - heat[i][2]);
             for c in v.iter_mut().take(3) {
@@ -103,12 +103,12 @@ mod tests {
             (0..st.len()).find(|&i| st.phase[i] == lid).unwrap(),
             (0..st.len()).find(|&i| st.phase[i] == wall).unwrap(),
         );
-        st.pos[a][0] = pr.period[0] - 1.0e-5;
+        st.pos[a][0] = pr.grid.period[0] - 1.0e-5;
         st.acc[a] = [1.0; 4];
         st.acc_b[a] = [1.0; 4];
         let (xa, xb) = (st.pos[a], st.pos[b]);
         super::kick_drift(&pr, &mut st);
-        assert_eq!(st.pos[a][0], (xa[0] + 0.01f32 * 2.0e-3) - pr.period[0]);
+        assert_eq!(st.pos[a][0], (xa[0] + 0.01f32 * 2.0e-3) - pr.grid.period[0]);
         assert_eq!(st.pos[a][1], xa[1]);
         assert_eq!(st.pos[b], xb);
     }

@@ -21,22 +21,22 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, KIND_GAS};
+use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
 use rayon::prelude::*;
 
 #[inline(always)]
 pub fn condensed(pr: &Params, phase: u32) -> bool {
-    pr.phase_a[phase as usize][3] != KIND_GAS
+    pr.phases[phase as usize].kind != KIND_GAS
 }
 
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
-    if pr.interface[2] != 0.0 {
+    if pr.flag(FLAG_GAS_INTERFACE) {
         return gas_interface(pr, st, grid);
     }
     let n = st.len();
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
-    let vol = |j: usize| mass[j] / pr.phase_a[phase[j] as usize][0];
+    let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
     let gamma: Vec<f32> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -52,7 +52,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             g
         })
         .collect();
-    let inv_h = pr.kernel[1];
+    let inv_h = pr.kernel.inv_h;
     let normals: Vec<[f32; 4]> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -72,7 +72,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             });
             let delta = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
             if delta > 0.1 * inv_h {
-                let scaled = delta * pr.interface[0];
+                let scaled = delta * pr.surfaces.inv_kappa;
                 [-g[0] / delta, -g[1] / delta, -g[2] / delta, scaled]
             } else {
                 [0.0; 4]
@@ -90,7 +90,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
 fn density(pr: &Params, st: &State, j: usize) -> f32 {
     let ph = st.phase[j];
     if pr.is_wall(ph) {
-        pr.phase_a[ph as usize][0]
+        pr.phases[ph as usize].rho0
     } else {
         st.rho[j]
     }
@@ -99,7 +99,7 @@ fn density(pr: &Params, st: &State, j: usize) -> f32 {
 /// F22 (19)–(20) between condensed particles and gas particles.
 fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
     let n = st.len();
-    let inv_h = pr.kernel[1];
+    let inv_h = pr.kernel.inv_h;
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let s: &State = st;
     let normals: Vec<[f32; 4]> = (0..n)
@@ -131,7 +131,7 @@ fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
                     g[0] / delta,
                     g[1] / delta,
                     g[2] / delta,
-                    delta * pr.interface[0],
+                    delta * pr.surfaces.inv_kappa,
                 ]
             } else {
                 [0.0; 4]

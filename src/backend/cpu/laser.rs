@@ -28,12 +28,12 @@ use rayon::prelude::*;
 /// Liquid and solid particles absorb; gas is transparent, walls take no heat.
 #[inline(always)]
 pub fn absorbs(pr: &Params, phase: u32) -> bool {
-    pr.conducts(phase) && pr.phase_a[phase as usize][3] != KIND_GAS
+    pr.conducts(phase) && pr.phases[phase as usize].kind != KIND_GAS
 }
 
 #[inline(always)]
 fn bin_centre(pr: &Params, k: [u32; 3]) -> [f32; 4] {
-    let (lo, dx) = (pr.laser_lo, pr.laser_grid[0]);
+    let (lo, dx) = (pr.laser.lo, pr.laser.bin_size);
     [
         lo[0] + (k[0] as f32 + 0.5) * dx,
         lo[1] + (k[1] as f32 + 0.5) * dx,
@@ -45,22 +45,22 @@ fn bin_centre(pr: &Params, k: [u32; 3]) -> [f32; 4] {
 /// Cloud-in-cell weight of a particle offset d from a bin centre.
 #[inline(always)]
 fn cic(pr: &Params, d: [f32; 3]) -> f32 {
-    let dx = pr.laser_grid[0];
+    let dx = pr.laser.bin_size;
     let mut w = 1.0f32;
-    for a in 0..pr.counts[2] as usize {
+    for a in 0..pr.sizes.dim as usize {
         w *= (1.0 - d[a].abs() / dx).max(0.0);
     }
     w
 }
 
 fn bin_index(pr: &Params, b: usize) -> [u32; 3] {
-    let nb = pr.laser_bins;
+    let nb = pr.laser.bins;
     let b = b as u32;
     [b % nb[0], (b / nb[0]) % nb[1], b / (nb[0] * nb[1])]
 }
 
 pub fn n_bins(pr: &Params) -> usize {
-    let nb = pr.laser_bins;
+    let nb = pr.laser.bins;
     (nb[0] * nb[1] * nb[2]) as usize
 }
 
@@ -73,7 +73,7 @@ pub fn bins(pr: &Params, st: &State, grid: &CellTable, bins: &mut Vec<[f32; 2]>)
             let mut sum = 0.0f32;
             for_each_near(pr, pos, grid, c, |j, d, _| {
                 if absorbs(pr, phase[j]) {
-                    let v = mass[j] / pr.phase_a[phase[j] as usize][0];
+                    let v = mass[j] / pr.phases[phase[j] as usize].rho0;
                     sum += cic(pr, d) * v;
                 }
             });
@@ -85,29 +85,29 @@ pub fn bins(pr: &Params, st: &State, grid: &CellTable, bins: &mut Vec<[f32; 2]>)
 /// Beam centre (lateral, grid-relative) at time t: linear along the path.
 #[inline(always)]
 pub fn beam_centre(pr: &Params, t: f32) -> [f32; 2] {
-    let n = (pr.laser_bins[3] % 256) as usize;
-    let path = &pr.laser_path;
-    if t <= path[0][0] {
-        return [path[0][1], path[0][2]];
+    let n = pr.laser.path_points as usize;
+    let path = &pr.laser.path;
+    if t <= path[0].time {
+        return [path[0].x, path[0].y];
     }
     for k in 1..n {
-        if t < path[k][0] {
+        if t < path[k].time {
             let (p0, p1) = (path[k - 1], path[k]);
-            let f = (t - p0[0]) / (p1[0] - p0[0]);
-            return [p0[1] + f * (p1[1] - p0[1]), p0[2] + f * (p1[2] - p0[2])];
+            let f = (t - p0.time) / (p1.time - p0.time);
+            return [p0.x + f * (p1.x - p0.x), p0.y + f * (p1.y - p0.y)];
         }
     }
-    [path[n - 1][1], path[n - 1][2]]
+    [path[n - 1].x, path[n - 1].y]
 }
 
 /// Beam power at time t: each step held from its time on, off before the first.
 #[inline(always)]
 pub fn beam_power(pr: &Params, t: f32) -> f32 {
-    let n = (pr.laser_bins[3] / 256) as usize;
+    let n = pr.laser.power_steps as usize;
     let mut p = 0.0f32;
     for k in 0..n {
-        if pr.laser_power[k][0] <= t {
-            p = pr.laser_power[k][1];
+        if pr.laser.power[k].time <= t {
+            p = pr.laser.power[k].power;
         }
     }
     p
@@ -118,14 +118,14 @@ pub fn beam_power(pr: &Params, t: f32) -> f32 {
 #[inline(always)]
 fn irradiance(pr: &Params, p: &[f32; 4], centre: [f32; 2], power: f32) -> f32 {
     let d0 = p[0] - centre[0];
-    let d1 = if pr.counts[2] == 3 {
+    let d1 = if pr.sizes.dim == 3 {
         p[1] - centre[1]
     } else {
         0.0
     };
     let r2 = d0 * d0 + d1 * d1;
-    let [zeta, rw, _, _] = pr.laser;
-    zeta * power * pr.laser_grid[1] * pm_exp(-(2.0 * r2 / (rw * rw)))
+    let (zeta, rw) = (pr.laser.absorptivity, pr.laser.radius);
+    zeta * power * pr.laser.peak_per_watt * pm_exp(-(2.0 * r2 / (rw * rw)))
 }
 
 /// Store each conducting particle's laser source q (W/kg) in heat.w.
@@ -139,8 +139,8 @@ fn write_source(pr: &Params, st: &mut State, q: &[f32]) {
 }
 
 pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
-    let nb = pr.laser_bins;
-    let dim = pr.counts[2] as usize;
+    let nb = pr.laser.bins;
+    let dim = pr.sizes.dim as usize;
     let (nx, ny) = (nb[0] as usize, nb[1] as usize);
     let (n_cols, depth) = if dim == 3 {
         (nx * ny, nb[2] as usize)
@@ -150,8 +150,9 @@ pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
     let stride = if dim == 3 { nx * ny } else { nx };
     let centre = beam_centre(pr, t);
     let power = beam_power(pr, t);
-    let a = pr.laser[2];
-    let [dx, _, vbin, area] = pr.laser_grid;
+    let a = pr.laser.absorption;
+    let l = &pr.laser;
+    let (dx, vbin, area) = (l.bin_size, l.bin_volume, l.column_area);
     let out: Vec<Vec<(usize, f32)>> = (0..n_cols)
         .into_par_iter()
         .map(|c| {
@@ -182,9 +183,9 @@ pub fn columns(pr: &Params, t: f32, bins: &mut [[f32; 2]]) {
 
 pub fn deposit(pr: &Params, st: &mut State, bins: &[[f32; 2]]) {
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
-    let nb = pr.laser_bins;
-    let dim = pr.counts[2] as usize;
-    let dx = pr.laser_grid[0];
+    let nb = pr.laser.bins;
+    let dim = pr.sizes.dim as usize;
+    let dx = pr.laser.bin_size;
     let q: Vec<f32> = (0..st.len())
         .into_par_iter()
         .map(|i| {
@@ -192,10 +193,10 @@ pub fn deposit(pr: &Params, st: &mut State, bins: &[[f32; 2]]) {
                 return 0.0;
             }
             let p = pos[i];
-            let v = mass[i] / pr.phase_a[phase[i] as usize][0];
+            let v = mass[i] / pr.phases[phase[i] as usize].rho0;
             let mut k = [0i32; 3];
             for a in 0..3 {
-                let f = ((p[a] - pr.laser_lo[a]) / dx).floor();
+                let f = ((p[a] - pr.laser.lo[a]) / dx).floor();
                 k[a] = (f as i32).clamp(0, nb[a] as i32 - 1);
             }
             let zr = if dim == 3 { 1 } else { 0 };
@@ -225,10 +226,10 @@ pub fn deposit(pr: &Params, st: &mut State, bins: &[[f32; 2]]) {
 fn bin_at(pr: &Params, k: [i32; 3]) -> Option<[u32; 3]> {
     let mut out = [0u32; 3];
     for a in 0..3 {
-        let n = pr.laser_bins[a] as i32;
+        let n = pr.laser.bins[a] as i32;
         out[a] = if k[a] >= 0 && k[a] < n {
             k[a] as u32
-        } else if pr.grid[3] & (1 << a) != 0 {
+        } else if pr.sizes.flags & (1 << a) != 0 {
             ((k[a] + n) % n) as u32
         } else {
             return None;
@@ -239,7 +240,7 @@ fn bin_at(pr: &Params, k: [i32; 3]) -> Option<[u32; 3]> {
 
 pub fn surface(pr: &Params, st: &mut State) {
     let n = st.len();
-    let up = pr.counts[2] as usize - 1;
+    let up = pr.sizes.dim as usize - 1;
     let centre = beam_centre(pr, st.sim.time);
     let power = beam_power(pr, st.sim.time);
     let (pos, phase, surf) = (&st.pos, &st.phase, &st.surface);
@@ -251,7 +252,7 @@ pub fn surface(pr: &Params, st: &mut State) {
             }
             let cos = surf[i][up].max(0.0);
             irradiance(pr, &pos[i], centre, power) * cos * surf[i][3]
-                / pr.phase_a[phase[i] as usize][0]
+                / pr.phases[phase[i] as usize].rho0
         })
         .collect();
     write_source(pr, st, &q);

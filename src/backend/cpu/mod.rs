@@ -13,7 +13,7 @@ mod timestep;
 mod wall;
 
 use super::{Backend, Pipeline, Stage};
-use crate::params::{Params, LASER_SURFACE};
+use crate::params::Params;
 use crate::state::{Sim, State};
 use std::time::Instant;
 
@@ -62,6 +62,50 @@ impl CpuBackend {
     }
 }
 
+/// The CPU twin of each stage, named as in the pass table (backend/passes.rs).
+impl CpuBackend {
+    pub(crate) fn kick_drift(&mut self) {
+        integrate::kick_drift(&self.params, &mut self.st)
+    }
+    pub(crate) fn neighbors(&mut self) {
+        neighbors::run(&self.params, &mut self.st, &mut self.grid)
+    }
+    pub(crate) fn density(&mut self) {
+        density::run(&self.params, &mut self.st, &self.grid, &mut self.list)
+    }
+    pub(crate) fn wall(&mut self) {
+        wall::run(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn interface(&mut self) {
+        interface::run(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn forces(&mut self) {
+        forces::run(&self.params, &mut self.st, &self.grid, &self.list)
+    }
+    pub(crate) fn laser(&mut self) {
+        let pr = &self.params;
+        if self.pipeline.features.laser_surface {
+            laser::surface(pr, &mut self.st);
+        } else {
+            laser::bins(pr, &self.st, &self.grid, &mut self.laser_bins);
+            laser::columns(pr, self.st.sim.time, &mut self.laser_bins);
+            laser::deposit(pr, &mut self.st, &self.laser_bins);
+        }
+    }
+    pub(crate) fn conduct(&mut self) {
+        heat::conduct(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn temperature(&mut self) {
+        heat::temperature(&self.params, &mut self.st)
+    }
+    pub(crate) fn kick(&mut self) {
+        integrate::kick(&self.params, &mut self.st)
+    }
+    pub(crate) fn timestep(&mut self) {
+        timestep::run(&self.params, &mut self.st)
+    }
+}
+
 impl Backend for CpuBackend {
     fn describe(&self) -> String {
         format!("cpu ({} threads)", rayon::current_num_threads())
@@ -74,25 +118,7 @@ impl Backend for CpuBackend {
     }
     fn run_stage(&mut self, stage: Stage) {
         let t0 = Instant::now();
-        let pr = &self.params;
-        match stage {
-            Stage::KickDrift => integrate::kick_drift(pr, &mut self.st),
-            Stage::Neighbors => neighbors::run(pr, &mut self.st, &mut self.grid),
-            Stage::Density => density::run(pr, &mut self.st, &self.grid, &mut self.list),
-            Stage::Wall => wall::run(pr, &mut self.st, &self.grid),
-            Stage::Forces => forces::run(pr, &mut self.st, &self.grid, &self.list),
-            Stage::Interface => interface::run(pr, &mut self.st, &self.grid),
-            Stage::Laser if pr.laser[3] == LASER_SURFACE => laser::surface(pr, &mut self.st),
-            Stage::Laser => {
-                laser::bins(pr, &self.st, &self.grid, &mut self.laser_bins);
-                laser::columns(pr, self.st.sim.time, &mut self.laser_bins);
-                laser::deposit(pr, &mut self.st, &self.laser_bins);
-            }
-            Stage::Heat => heat::conduct(pr, &mut self.st, &self.grid),
-            Stage::Temperature => heat::temperature(pr, &mut self.st),
-            Stage::Kick => integrate::kick(pr, &mut self.st),
-            Stage::Timestep => timestep::run(pr, &mut self.st),
-        }
+        (stage.def().cpu)(self);
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         let name = stage.name();
         match self.times.iter_mut().find(|(n, _)| *n == name) {

@@ -44,21 +44,21 @@ pub fn fluid_nearby(pr: &Params, grid: &CellTable, pi: &[f32; 4]) -> bool {
 #[inline(always)]
 fn for_each_cell(pr: &Params, pi: &[f32; 4], mut f: impl FnMut(usize) -> bool) -> bool {
     let ci = cell_coord(pr, pi);
-    let zr = if pr.counts[2] == 3 { 1 } else { 0 };
-    let flags = pr.grid[3];
+    let zr = if pr.sizes.dim == 3 { 1 } else { 0 };
+    let flags = pr.sizes.flags;
     for dz in -zr..=zr {
-        let Some(cz) = wrap(ci[2] + dz, pr.grid[2], flags & 4 != 0) else {
+        let Some(cz) = wrap(ci[2] + dz, pr.grid.cells[2], flags & 4 != 0) else {
             continue;
         };
         for dy in -1..=1 {
-            let Some(cy) = wrap(ci[1] + dy, pr.grid[1], flags & 2 != 0) else {
+            let Some(cy) = wrap(ci[1] + dy, pr.grid.cells[1], flags & 2 != 0) else {
                 continue;
             };
             for dx in -1..=1 {
-                let Some(cx) = wrap(ci[0] + dx, pr.grid[0], flags & 1 != 0) else {
+                let Some(cx) = wrap(ci[0] + dx, pr.grid.cells[0], flags & 1 != 0) else {
                     continue;
                 };
-                if !f((cx + pr.grid[0] * (cy + pr.grid[1] * cz)) as usize) {
+                if !f((cx + pr.grid.cells[0] * (cy + pr.grid.cells[1] * cz)) as usize) {
                     return false;
                 }
             }
@@ -72,15 +72,15 @@ fn for_each_cell(pr: &Params, pi: &[f32; 4], mut f: impl FnMut(usize) -> bool) -
 pub fn cell_coord(pr: &Params, p: &[f32; 4]) -> [i32; 3] {
     let mut c = [0i32; 3];
     for a in 0..3 {
-        let f = (p[a] * pr.cell_inv[a]).floor();
-        c[a] = (f as i32).clamp(0, pr.grid[a] as i32 - 1);
+        let f = (p[a] * pr.grid.cell_inv[a]).floor();
+        c[a] = (f as i32).clamp(0, pr.grid.cells[a] as i32 - 1);
     }
     c
 }
 
 #[inline(always)]
 pub fn cell_index(pr: &Params, c: [i32; 3]) -> u32 {
-    c[0] as u32 + pr.grid[0] * (c[1] as u32 + pr.grid[1] * c[2] as u32)
+    c[0] as u32 + pr.grid.cells[0] * (c[1] as u32 + pr.grid.cells[1] * c[2] as u32)
 }
 
 /// Visit every neighbour j of particle i with r_ij² < support², in the fixed order
@@ -334,8 +334,8 @@ impl Candidates {
             for (d, &s) in d.iter_mut().zip(src) {
                 *d = pi[a] - s;
             }
-            if pr.grid[3] & (1 << a) != 0 {
-                let (half, period) = (pr.half_period[a], pr.period[a]);
+            if pr.sizes.flags & (1 << a) != 0 {
+                let (half, period) = (pr.grid.half_period[a], pr.grid.period[a]);
                 for d in d.iter_mut() {
                     *d = wrap_axis(*d, half, period);
                 }
@@ -345,7 +345,7 @@ impl Candidates {
         for (k, r2) in self.r2[..n].iter_mut().enumerate() {
             *r2 = dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k];
         }
-        let support2 = pr.kernel[3];
+        let support2 = pr.kernel.support2;
         // Branch-free compaction: every candidate is written at `count`, which
         // advances only past a neighbour (count <= k, so it stays in bounds).
         let (hits, hit_r2) = (&mut self.hits[..n], &mut self.hit_r2[..n]);
@@ -373,7 +373,7 @@ pub fn for_each_near(
         for j in grid.start[c] as usize..grid.end[c] as usize {
             let d = min_image(pr, pi, pos[j]);
             let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            if r2 < pr.kernel[3] {
+            if r2 < pr.kernel.support2 {
                 f(j, d, r2);
             }
         }
@@ -386,8 +386,8 @@ pub fn for_each_near(
 pub fn min_image(pr: &Params, a: [f32; 4], b: [f32; 4]) -> [f32; 3] {
     let mut d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     for k in 0..3 {
-        if pr.grid[3] & (1 << k) != 0 {
-            d[k] = wrap_axis(d[k], pr.half_period[k], pr.period[k]);
+        if pr.sizes.flags & (1 << k) != 0 {
+            d[k] = wrap_axis(d[k], pr.grid.half_period[k], pr.grid.period[k]);
         }
     }
     d
@@ -438,7 +438,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     if !st.heat.is_empty() {
         permute(&mut st.heat, &perm);
     }
-    let n_cells = pr.counts[1] as usize;
+    let n_cells = pr.sizes.n_cells as usize;
     grid.invalidate();
     grid.start.clear();
     grid.start.resize(n_cells, 0);

@@ -35,19 +35,19 @@ pub fn run(pr: &Params, st: &mut State) {
 /// 4 conduction (0.1 ρ c_p h²/k, issue 4). A scene without fluid has no acoustic
 /// limit (c_max = 0, |u| = 0).
 pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
-    let h = pr.dt[0];
-    let speed = pr.dt[1] + umax2.sqrt();
+    let h = pr.kernel.h;
+    let speed = pr.time_step.max_sound_speed + umax2.sqrt();
     let mut dt = f32::MAX;
     if speed > 0.0 {
         dt = 0.25 * h / speed;
     }
     let mut which = 0u32;
-    if pr.dt[2] < dt {
-        dt = pr.dt[2];
+    if pr.time_step.viscous_limit < dt {
+        dt = pr.time_step.viscous_limit;
         which = 1;
     }
-    if pr.heat[0] < dt {
-        dt = pr.heat[0];
+    if pr.time_step.conduction_limit < dt {
+        dt = pr.time_step.conduction_limit;
         which = 4;
     }
     if amax2 > 0.0 {
@@ -57,8 +57,8 @@ pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
             which = 2;
         }
     }
-    if pr.dt[3] > 0.0 {
-        dt = pr.dt[3];
+    if pr.time_step.fixed_dt > 0.0 {
+        dt = pr.time_step.fixed_dt;
         which = 3;
     }
     (dt, which)

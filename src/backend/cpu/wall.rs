@@ -57,8 +57,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                     sv[a] += v[a] * wk;
                 }
             });
-            let b = pr.phase_b[ph as usize];
-            let m = pr.phase_a[ph as usize];
+            let b = pr.phase(ph).velocity;
+            let m = pr.phase(ph);
             // Regularised Shepard division: Σ W + ε instead of Σ W, ε = 1e-9 W(0).
             // At an exact lattice tie a fluid particle sits at the edge of the
             // support, where W is 0 or a few ULP above it depending on rounding; a
@@ -67,8 +67,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             // picks the other side. With ε the result goes to 0 continuously as
             // Σ W -> 0, and for Σ W ≥ 1e-4 W(0) (every fluid neighbour closer than
             // 2.6h with the quintic) ε changes it by at most 1e-5 relative.
-            let g = pr.gravity;
-            let den = sw + pr.wall[0];
+            let g = pr.flow.gravity;
+            let den = sw + pr.flow.wall_weight_floor;
             let mut p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / den;
             let v = [
                 b[0] + (b[0] * sw - sv[0]) / den,
@@ -76,10 +76,10 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                 b[2] + (b[2] * sw - sv[2]) / den,
                 0.0,
             ];
-            if pr.grid[3] & FLAG_PRESSURE_FLOOR != 0 {
+            if pr.flag(FLAG_PRESSURE_FLOOR) {
                 p = p.max(0.0);
             }
-            Some((m[0] + p / m[1], p, v))
+            Some((m.rho0 + p / m.c2, p, v))
         })
         .collect();
     for (i, o) in out.into_iter().enumerate() {
@@ -129,7 +129,7 @@ mod tests {
         neighbors::run(&pr, &mut st, &mut grid);
         super::run(&pr, &mut st, &grid);
         let k = st.id.iter().position(|&id| id == w as u32).unwrap();
-        (st.p[k], st.vel[k], pr.kernel[3].sqrt())
+        (st.p[k], st.vel[k], pr.kernel.support2.sqrt())
     }
 
     /// Adami's extrapolation p_w = p_f + ρ_f g·(r_w − r_f) with one neighbour well

@@ -8,8 +8,8 @@ pub mod shaders;
 
 pub use context::{AdapterChoice, GpuContext};
 
-use super::{Backend, Pipeline, Stage};
-use crate::params::{Params, LASER_BEER_LAMBERT, LASER_SURFACE};
+use super::{entry_points, Backend, Pipeline, Stage, Work};
+use crate::params::{Params, FLAG_HEAT, FLAG_INTERFACE, LASER_BEER_LAMBERT};
 use crate::state::{Sim, State};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
@@ -18,31 +18,6 @@ const WG: u32 = 64;
 const REDUCE_WG: u32 = 256;
 /// Stride between sort-stage uniforms (the usual min_uniform_buffer_offset_alignment).
 const STAGE_STRIDE: u64 = 256;
-
-/// (pipeline name, shader file, entry point)
-pub const ENTRY_POINTS: [(&str, &str, &str); 21] = [
-    ("cell_keys", "neighbors", "cell_keys"),
-    ("bitonic_global", "neighbors", "bitonic_global"),
-    ("bitonic_local", "neighbors", "bitonic_local"),
-    ("reorder", "neighbors", "reorder"),
-    ("cell_bounds", "neighbors", "cell_bounds"),
-    ("density", "density", "density"),
-    ("wall", "wall", "wall"),
-    ("forces", "forces", "forces"),
-    ("kick_drift", "integrate", "kick_drift"),
-    ("kick", "integrate", "kick"),
-    ("reduce", "timestep", "reduce"),
-    ("finalize", "timestep", "finalize"),
-    ("wall_temperature", "heat", "wall_temperature"),
-    ("conduct", "heat", "conduct"),
-    ("temperature", "heat", "temperature"),
-    ("laser_bins", "laser", "laser_bins"),
-    ("laser_columns", "laser", "laser_columns"),
-    ("laser_deposit", "laser", "laser_deposit"),
-    ("laser_surface", "laser", "laser_surface"),
-    ("shepard", "interface", "shepard"),
-    ("normals", "interface", "normals"),
-];
 
 struct Buffers {
     params: wgpu::Buffer,
@@ -109,7 +84,7 @@ impl GpuBackend {
         let n = st.len() as u32;
         let n_pad = n.next_power_of_two().max(2);
         let device = &ctx.device;
-        let n_cells = params.counts[1] as u64;
+        let n_cells = params.sizes.n_cells as u64;
         let limit = ctx.limits.max_storage_buffer_binding_size as u64;
         let biggest = (n as u64 * 16).max(n_pad as u64 * 8).max(n_cells * 4);
         if biggest > limit {
@@ -244,12 +219,28 @@ impl GpuBackend {
     }
 
     fn thermal(&self) -> bool {
-        self.params.heat[2] != 0.0
+        self.params.flag(FLAG_HEAT)
     }
 
-    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, threads: u32) {
-        pass.set_pipeline(&self.pipelines[name]);
-        let (x, y) = grid_for(threads.div_ceil(WG));
+    /// Dispatch entry point `entry` over its work (a thread per particle, per
+    /// laser bin, ...; the pass table says which).
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, entry: &str, work: Work) {
+        pass.set_pipeline(&self.pipelines[entry]);
+        let p = &self.params;
+        let groups = match work {
+            Work::Particles => self.n.div_ceil(WG),
+            Work::SortKeys => self.n_pad.div_ceil(WG),
+            Work::LaserBins => laser_bin_count(p).div_ceil(WG),
+            Work::LaserColumns => {
+                let b = p.laser.bins;
+                let cols = if p.sizes.dim == 3 { b[0] * b[1] } else { b[0] };
+                cols.div_ceil(WG)
+            }
+            Work::Reduction => self.n.div_ceil(REDUCE_WG),
+            Work::Single => 1,
+            Work::Sort => unreachable!("the bitonic sort is scheduled by encode_neighbors"),
+        };
+        let (x, y) = grid_for(groups);
         pass.dispatch_workgroups(x, y, 1);
     }
 
@@ -287,72 +278,23 @@ impl GpuBackend {
         pass
     }
 
-    /// Record one stage. `idx` is the stage's timestamp slot when profiling.
+    /// Record one stage: its entry points in the pass table's order, those the
+    /// scene's features call for. `idx` is the stage's timestamp slot when profiling.
     fn encode_stage(&self, enc: &mut wgpu::CommandEncoder, stage: Stage, idx: u32) {
-        let n = self.n;
-        match stage {
-            Stage::Neighbors => self.encode_neighbors(enc, idx),
-            Stage::Interface => {
-                let mut pass = self.begin_pass(enc, stage, idx);
-                // F22's gas-interface form needs no Shepard sums.
-                if self.params.interface[2] == 0.0 {
-                    self.dispatch(&mut pass, "shepard", n);
-                }
-                self.dispatch(&mut pass, "normals", n);
-            }
-            Stage::Laser if self.params.laser[3] == LASER_SURFACE => {
-                let mut pass = self.begin_pass(enc, stage, idx);
-                self.dispatch(&mut pass, "laser_surface", n);
-            }
-            Stage::Laser => {
-                let mut pass = self.begin_pass(enc, stage, idx);
-                let p = &self.params;
-                let cols = if p.counts[2] == 3 {
-                    p.laser_bins[0] * p.laser_bins[1]
-                } else {
-                    p.laser_bins[0]
-                };
-                self.dispatch(&mut pass, "laser_bins", laser_bin_count(p));
-                self.dispatch(&mut pass, "laser_columns", cols);
-                self.dispatch(&mut pass, "laser_deposit", n);
-            }
-            Stage::Heat => {
-                let mut pass = self.begin_pass(enc, stage, idx);
-                self.dispatch(&mut pass, "wall_temperature", n);
-                self.dispatch(&mut pass, "conduct", n);
-            }
-            Stage::Timestep => {
-                let mut pass = self.begin_pass(enc, stage, idx);
-                pass.set_pipeline(&self.pipelines["reduce"]);
-                let (x, y) = grid_for(n.div_ceil(REDUCE_WG));
-                pass.dispatch_workgroups(x, y, 1);
-                pass.set_pipeline(&self.pipelines["finalize"]);
-                pass.dispatch_workgroups(1, 1, 1);
-            }
-            _ => {
-                let name = match stage {
-                    Stage::KickDrift => "kick_drift",
-                    Stage::Density => "density",
-                    Stage::Wall => "wall",
-                    Stage::Forces => "forces",
-                    Stage::Kick => "kick",
-                    Stage::Temperature => "temperature",
-                    Stage::Neighbors
-                    | Stage::Timestep
-                    | Stage::Heat
-                    | Stage::Laser
-                    | Stage::Interface => unreachable!(),
-                };
-                let mut pass = self.begin_pass(enc, stage, idx);
-                self.dispatch(&mut pass, name, n);
-            }
+        if stage == Stage::Neighbors {
+            return self.encode_neighbors(enc, idx);
+        }
+        let features = &self.pipeline.features;
+        let mut pass = self.begin_pass(enc, stage, idx);
+        for d in stage.def().gpu.iter().filter(|d| (d.when)(features)) {
+            self.dispatch(&mut pass, d.entry, d.work);
         }
     }
 
     fn encode_neighbors(&self, enc: &mut wgpu::CommandEncoder, idx: u32) {
         {
             let mut pass = self.begin_pass_marked(enc, "neighbors.sort", idx, true, false);
-            self.dispatch(&mut pass, "cell_keys", self.n_pad);
+            self.dispatch(&mut pass, "cell_keys", Work::SortKeys);
             for (s, step) in self.sort_steps.iter().enumerate() {
                 let (name, groups) = match step {
                     SortStep::Global { .. } => ("bitonic_global", (self.n_pad / 2).div_ceil(WG)),
@@ -363,7 +305,7 @@ impl GpuBackend {
                 let (x, y) = grid_for(groups);
                 pass.dispatch_workgroups(x, y, 1);
             }
-            self.dispatch(&mut pass, "reorder", self.n);
+            self.dispatch(&mut pass, "reorder", Work::Particles);
         }
         let b = &self.buf;
         let targets = [&b.pos, &b.vel, &b.acc, &b.acc_b, &b.mass, &b.phase, &b.id];
@@ -377,7 +319,7 @@ impl GpuBackend {
         enc.clear_buffer(&b.cell_end, 0, None);
         enc.clear_buffer(&b.cell_fluid, 0, None);
         let mut pass = self.begin_pass_marked(enc, "neighbors.cell_bounds", idx, false, true);
-        self.dispatch(&mut pass, "cell_bounds", self.n);
+        self.dispatch(&mut pass, "cell_bounds", Work::Particles);
     }
 
     fn submit(&self, enc: wgpu::CommandEncoder) {
@@ -452,10 +394,10 @@ impl Profiler {
 
 /// Laser bins in the scene (0 without a laser).
 fn laser_bin_count(p: &Params) -> u32 {
-    if p.laser[3] != LASER_BEER_LAMBERT {
+    if p.laser.model != LASER_BEER_LAMBERT {
         return 0;
     }
-    p.laser_bins[0] * p.laser_bins[1] * p.laser_bins[2]
+    p.laser.bins[0] * p.laser.bins[1] * p.laser.bins[2]
 }
 
 /// Workgroup grid for `groups` groups: x up to 65535, the rest in y.
@@ -644,23 +586,23 @@ fn build_pipelines(
         bind_group_layouts: &[Some(layout), Some(sort_layout)],
         immediate_size: 0,
     });
-    ENTRY_POINTS
-        .iter()
-        .map(|(name, file, entry)| {
-            let pl = if name.starts_with("bitonic") {
+    entry_points()
+        .into_iter()
+        .map(|(entry, file)| {
+            let pl = if entry.starts_with("bitonic") {
                 &sorting
             } else {
                 &plain
             };
             let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
+                label: Some(entry),
                 layout: Some(pl),
                 module: &modules[file],
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
             });
-            (*name, p)
+            (entry, p)
         })
         .collect()
 }
@@ -730,7 +672,7 @@ impl Backend for GpuBackend {
             } else {
                 Vec::new()
             },
-            surface: if self.params.heat[3] != 0.0 {
+            surface: if self.params.flag(FLAG_INTERFACE) {
                 bytemuck::cast_slice(&self.read_bytes(&b.surface, 2 * self.n as u64 * 16)).to_vec()
             } else {
                 Vec::new()
@@ -741,7 +683,7 @@ impl Backend for GpuBackend {
     fn load_state(&mut self, st: &State) {
         assert_eq!(
             st.len() as u32,
-            self.params.counts[0],
+            self.params.sizes.n_particles,
             "load_state: particle count changed"
         );
         self.upload(st);

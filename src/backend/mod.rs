@@ -6,6 +6,7 @@ pub mod cpu;
 pub mod gpu;
 
 mod passes;
+pub mod terms;
 
 pub use passes::{entry_points, Dispatch, Features, Stage, StageDef, Work, PRIME, STAGES, STEP};
 

@@ -6,34 +6,54 @@
 //! and gravity. A wall neighbour enters with the pressure the wall pass extrapolated,
 //! the density the fluid's own EOS gives at that pressure, the fluid's mass and
 //! viscosity, and the no-slip velocity (no viscous term for free-slip walls).
-//! With viscous heating on, acc.w carries the power the viscous terms dissipate,
-//! −Σ_j s_ij (V_i² + V_j²) η̃_ij (∂W/∂r / r_ij) u_ij·w_ij per unit mass: a fluid
-//! pair has w = u_ij and s = ½ (both sides count it); a wall pair w = u_i − U_wall
-//! and s = 1, so that heat = wall work − kinetic-energy change exactly.
-//! With `interface_viscosity` on, fluid pairs add the F22 (31)–(32) interface
-//! viscosity, written so that it dissipates (u_ij·r_ij < 0 repels):
-//!   F_d,i = m_i Σ_j m_j ᾱ_ij h c̄_ij/ρ̄_ij (u_ij·r_ij)/(r_ij² + 0.01 h²) ∂W/∂r e_ij,
-//!   α_i = α_0^lg min(h δ_i, 1) (δ from the interface pass), ᾱ_ij = (α_i + α_j)/2:
-//! the pair mean where F22 writes α_i, so that momentum is conserved pairwise, and
-//! h δ capped at 1 so that α ≤ α_0^lg, the bound the viscous Δt limit uses
-//! (h δ exceeds 1 only at wall–liquid–gas corners: 1.05 measured in two_layer_2d).
-//! Its dissipation is not added to the viscous heating.
+//! Each pair term is a function in cpu/terms/ (the twin of shaders/terms/), called
+//! in the order of backend::terms::PAIR_TERMS: pressure and viscosity (summed into
+//! one force, as F22 (23) writes them), background pressure (into acc_b), the
+//! interface viscosity F22 (31)–(32) and the viscous heating (into acc.w).
 
 use super::neighbors::{for_each_listed, CellTable, NeighborList};
+use super::terms;
+use crate::backend::terms::active;
 use crate::kernel;
 use crate::model::MAX_PHASES;
-use crate::params::{Params, FLAG_VISCOUS_HEATING, KIND_WALL, PHASE_FREE_SLIP};
+use crate::params::{Params, KIND_WALL, PHASE_FREE_SLIP};
 use crate::state::State;
 use rayon::prelude::*;
 
+/// The sweep with the scene's switchable pair terms compiled in and the others
+/// compiled out (backend::terms).
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
+    let on = [
+        active(pr, "background_pressure"),
+        active(pr, "interface_viscosity"),
+        active(pr, "viscous_heating"),
+    ];
+    match on {
+        [false, false, false] => sweep::<false, false, false>(pr, st, grid, list),
+        [false, false, true] => sweep::<false, false, true>(pr, st, grid, list),
+        [false, true, false] => sweep::<false, true, false>(pr, st, grid, list),
+        [false, true, true] => sweep::<false, true, true>(pr, st, grid, list),
+        [true, false, false] => sweep::<true, false, false>(pr, st, grid, list),
+        [true, false, true] => sweep::<true, false, true>(pr, st, grid, list),
+        [true, true, false] => sweep::<true, true, false>(pr, st, grid, list),
+        [true, true, true] => sweep::<true, true, true>(pr, st, grid, list),
+    }
+}
+
+/// One fused neighbour sweep: BG, IV, VH switch the background pressure, the
+/// interface viscosity and the viscous heating.
+fn sweep<const BG: bool, const IV: bool, const VH: bool>(
+    pr: &Params,
+    st: &mut State,
+    grid: &CellTable,
+    list: &NeighborList,
+) {
     let (pos, vel, rho, p, mass, phase) = (&st.pos, &st.vel, &st.rho, &st.p, &st.mass, &st.phase);
     let surface = &st.surface;
     // Per particle and per phase pair once, what the pair loop would otherwise
     // compute per pair from the same operands: the same bits, fewer divisions.
     let eta_pair = PairViscosity::new(pr);
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
-    let background = pr.flow.background_pressure != 0.0;
     st.acc
         .par_iter_mut()
         .zip(st.acc_b.par_iter_mut())
@@ -51,10 +71,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
             let mut f = [0.0f32; 3];
             let mut fb = [0.0f32; 3];
             let mut heating = 0.0f32;
-            let viscous_heating = pr.flag(FLAG_VISCOUS_HEATING);
-            let (h, alpha0) = (pr.kernel.h, pr.flow.interface_viscosity);
-            let alpha_i = if alpha0 > 0.0 {
-                alpha0 * (h * surface[i][3]).min(1.0)
+            let alpha_i = if IV {
+                terms::interface_viscosity_alpha(pr, surface[i][3])
             } else {
                 0.0
             };
@@ -75,48 +93,38 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
                     (rho[j], mass[j], vol[j])
                 };
                 let vv = vol_i * vol_i + vol_j * vol_j;
-                let p_avg = (rho_j * p_i + rho_i * p_j) / (rho_i + rho_j);
-                let eta_avg = eta_pair.get(ph_i, ph_j);
-                let fp = -p_avg * dwdr / r;
-                let fv = eta_avg * dwdr / r;
+                // The pair terms, in the order of backend::terms::PAIR_TERMS.
+                let fp = terms::pressure(p_i, p_j, rho_i, rho_j, dwdr, r);
+                let fv = terms::viscosity(eta_pair.get(ph_i, ph_j), dwdr, r);
                 let v_j = vel[j];
                 for a in 0..3 {
                     let u = v_i[a] - v_j[a];
                     f[a] += vv * (fp * d[a] + fv * u);
                 }
-                // With p_b = 0 every term is ±0 and the sum stays +0: skipped.
-                if background {
-                    let fbg = -pb * dwdr / r;
+                if BG {
+                    let fbg = terms::background_pressure(pb, dwdr, r);
                     for a in 0..3 {
                         fb[a] += vv * (fbg * d[a]);
                     }
                 }
-                if alpha0 > 0.0 && !wall {
-                    let alpha = (alpha_i + alpha0 * (h * surface[j][3]).min(1.0)) * 0.5;
-                    let pair = Pair {
-                        m: [m_i, m_j],
-                        rho: [rho_i, rho_j],
-                        c2: [mat_i.c2, mat_j.c2],
-                        u: [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]],
-                    };
-                    let s = interface_viscosity(pr, &pair, d, r2, dwdr, alpha);
+                if IV && !wall {
+                    let alpha =
+                        (alpha_i + terms::interface_viscosity_alpha(pr, surface[j][3])) * 0.5;
+                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                    let s = terms::interface_viscosity(
+                        pr, m_i, m_j, rho_i, rho_j, mat_i.c2, mat_j.c2, u, d, r2, dwdr, alpha,
+                    );
                     for a in 0..3 {
                         f[a] += s * d[a];
                     }
                 }
-                if viscous_heating {
-                    // Power the pair's viscous force dissipates: fluid pairs share
-                    // F·(u_i − u_j); against a wall it is F·(u_i − U_wall) with the
-                    // wall's real velocity (the mirrored one is a ghost).
+                if VH {
                     let (w, share) = if wall {
                         (mat_j.velocity, 1.0)
                     } else {
                         (v_j, 0.5)
                     };
-                    let (ux, uy, uz) = (v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]);
-                    let (wx, wy, wz) = (v_i[0] - w[0], v_i[1] - w[1], v_i[2] - w[2]);
-                    let uw = ux * wx + uy * wy + uz * wz;
-                    heating -= share * vv * fv * uw;
+                    heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
                 }
             });
             let g = pr.flow.gravity;
@@ -130,8 +138,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
         });
 }
 
-/// η̃_ij = 2η_iη_j/(η_i + η_j) for every (fluid phase i, phase j): a wall
-/// neighbour takes the fluid's own η, and a free-slip wall or η_i + η_j = 0 gives 0.
+/// η̃_ij for every (fluid phase i, phase j), from `terms::pair_viscosity`: a wall
+/// neighbour takes the fluid's own η, and a free-slip wall gives 0.
 struct PairViscosity([[f32; MAX_PHASES]; MAX_PHASES]);
 
 impl PairViscosity {
@@ -143,12 +151,7 @@ impl PairViscosity {
                 let wall = pr.phases[j].kind >= KIND_WALL;
                 let slip = wall && pr.phases[j].flags & PHASE_FREE_SLIP != 0;
                 let eta_j = if wall { eta_i } else { pr.phases[j].eta };
-                let eta_sum = eta_i + eta_j;
-                *eta = if eta_sum > 0.0 && !slip {
-                    2.0 * eta_i * eta_j / eta_sum
-                } else {
-                    0.0
-                };
+                *eta = terms::pair_viscosity(eta_i, eta_j, slip);
             }
         }
         PairViscosity(t)
@@ -157,22 +160,4 @@ impl PairViscosity {
     fn get(&self, i: u32, j: u32) -> f32 {
         self.0[i as usize][j as usize]
     }
-}
-
-/// What F22 (31) needs of a fluid pair i, j: masses, densities, c², u_i − u_j.
-struct Pair {
-    m: [f32; 2],
-    rho: [f32; 2],
-    c2: [f32; 2],
-    u: [f32; 3],
-}
-
-/// F22 (31) for one fluid pair: the factor of r_ij in the force on i.
-#[inline(always)]
-fn interface_viscosity(pr: &Params, q: &Pair, d: [f32; 3], r2: f32, dwdr: f32, alpha: f32) -> f32 {
-    let c = (q.c2[0].sqrt() + q.c2[1].sqrt()) * 0.5;
-    let rho = (q.rho[0] + q.rho[1]) * 0.5;
-    let ur = q.u[0] * d[0] + q.u[1] * d[1] + q.u[2] * d[2];
-    let r = r2.sqrt();
-    q.m[0] * q.m[1] * alpha * pr.kernel.h * c / rho * ur / (r2 + pr.kernel.eta2) * dwdr / r
 }

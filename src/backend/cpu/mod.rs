@@ -9,6 +9,7 @@ mod integrate;
 mod interface;
 mod laser;
 mod neighbors;
+mod terms;
 mod timestep;
 mod wall;
 

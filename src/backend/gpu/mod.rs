@@ -161,7 +161,7 @@ impl GpuBackend {
         });
         // A shader the driver rejects is an error of this run, not a panic.
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipelines = build_pipelines(device, &layout, &sort_layout);
+        let pipelines = build_pipelines(device, &layout, &sort_layout, &params);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(format!("GPU pipeline creation failed: {e}"));
         }
@@ -555,7 +555,8 @@ pub fn shader_sources() -> Vec<(&'static str, String)> {
     shaders::PASSES
         .iter()
         .map(|(name, src)| {
-            let full = shaders::compose(src).unwrap_or_else(|e| panic!("shaders/{name}.wgsl: {e}"));
+            let full =
+                shaders::compose(name, src).unwrap_or_else(|e| panic!("shaders/{name}.wgsl: {e}"));
             (*name, full)
         })
         .collect()
@@ -565,6 +566,7 @@ fn build_pipelines(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     sort_layout: &wgpu::BindGroupLayout,
+    params: &Params,
 ) -> HashMap<&'static str, wgpu::ComputePipeline> {
     let modules: HashMap<&str, wgpu::ShaderModule> = shader_sources()
         .into_iter()
@@ -594,12 +596,18 @@ fn build_pipelines(
             } else {
                 &plain
             };
+            // The pass's switchable pair terms: a term the scene does not use is
+            // compiled out here, not skipped per pair.
+            let switches = super::terms::switches(file, params);
             let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(pl),
                 module: &modules[file],
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &switches,
+                    ..Default::default()
+                },
                 cache: None,
             });
             (entry, p)

@@ -72,12 +72,16 @@ fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
     Ok((0..LIBS.len()).filter(|&k| need[k]).collect())
 }
 
-/// A pass's complete source: its libraries, then the pass with every neighbour
-/// walk expanded.
-pub fn compose(pass: &str) -> Result<String, String> {
+/// A pass's complete source: its libraries, its pair terms (backend::terms), then
+/// the pass with every neighbour walk expanded.
+pub fn compose(name: &str, pass: &str) -> Result<String, String> {
     let mut out = String::new();
     for k in resolve(&uses(pass))? {
         out.push_str(LIBS[k].1);
+        out.push('\n');
+    }
+    for term in crate::backend::terms::wgsl_for(name) {
+        out.push_str(term);
         out.push('\n');
     }
     out.push_str(&expand_walks(pass)?);
@@ -191,13 +195,13 @@ mod tests {
     fn an_unclosed_walk_or_a_missing_library_is_an_error() {
         assert!(expand_walks("    #for_each_neighbor(ci, zr, j) {\n        x;\n").is_err());
         assert!(expand_walks("    #for_each_neighbor(ci, j) {\n    }\n").is_err());
-        assert!(compose("// uses: params nonsense\n").is_err());
+        assert!(compose("x", "// uses: params nonsense\n").is_err());
     }
 
     #[test]
     fn libraries_come_before_their_users_and_once() {
         // kernel uses consts, which uses params: all three, in LIBS order.
-        let src = compose("// uses: kernel\nfn f() {}\n").unwrap();
+        let src = compose("x", "// uses: kernel\nfn f() {}\n").unwrap();
         let at = |needle: &str| src.find(needle).unwrap();
         assert!(at("struct Params") < at("fn c_half") && at("fn c_half") < at("fn kernel_w"));
         assert_eq!(src.matches("struct Params").count(), 1);

@@ -1,0 +1,14 @@
+//! CPU twins of the pair terms in shaders/terms/ (registry: backend::terms), one
+//! file each, same name, arguments and operation order as the WGSL function.
+
+mod background_pressure;
+mod interface_viscosity;
+mod pressure;
+mod viscosity;
+mod viscous_heating;
+
+pub use background_pressure::background_pressure;
+pub use interface_viscosity::{interface_viscosity, interface_viscosity_alpha};
+pub use pressure::pressure;
+pub use viscosity::{pair_viscosity, viscosity};
+pub use viscous_heating::viscous_heating;

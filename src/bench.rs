@@ -53,14 +53,20 @@ fn scene_of_size(target: f64) -> Result<Loaded, SpatterError> {
     Ok(l)
 }
 
-fn measure(l: &Loaded, backend: &mut dyn Backend, steps: u32, pairs: u64) -> BenchRow {
+fn measure(
+    l: &Loaded,
+    backend: &mut dyn Backend,
+    steps: u32,
+    pairs: u64,
+) -> Result<BenchRow, SpatterError> {
+    let lost = |e: crate::backend::DeviceLost| SpatterError::Runtime(e.to_string());
     backend.prime();
     backend.run_steps(2);
-    backend.read_sim();
+    backend.read_sim().map_err(lost)?;
     backend.take_pass_times();
     let t0 = Instant::now();
     backend.run_steps(steps);
-    backend.read_sim();
+    backend.read_sim().map_err(lost)?;
     let wall_s = t0.elapsed().as_secs_f64();
     let n = l.state.len();
     let fluid = l
@@ -70,7 +76,7 @@ fn measure(l: &Loaded, backend: &mut dyn Backend, steps: u32, pairs: u64) -> Ben
         .filter(|&&p| l.model.phases[p as usize].is_fluid())
         .count()
         .max(1);
-    BenchRow {
+    Ok(BenchRow {
         backend: backend.describe(),
         particles: n,
         dx: l.model.dx,
@@ -80,7 +86,7 @@ fn measure(l: &Loaded, backend: &mut dyn Backend, steps: u32, pairs: u64) -> Ben
         pair_interactions_per_s: pairs as f64 * steps as f64 / wall_s,
         neighbours_per_fluid_particle: pairs as f64 / fluid as f64,
         pass_ms: Vec::new(),
-    }
+    })
 }
 
 fn per_step(times: Vec<(&'static str, f64)>, steps: u32) -> Vec<(String, f64)> {
@@ -108,7 +114,7 @@ pub fn throughput(
         let pairs = cpu.pair_count();
         if want_cpu {
             let mut cpu = CpuBackend::new(params, l.state.clone());
-            let mut row = measure(&l, &mut cpu, steps, pairs);
+            let mut row = measure(&l, &mut cpu, steps, pairs)?;
             row.pass_ms = per_step(cpu.take_pass_times(), steps);
             print_row(&row);
             rows.push(row);
@@ -128,7 +134,7 @@ pub fn throughput(
             }
             let mut gpu =
                 GpuBackend::new(ctx, params, &l.state, false).map_err(SpatterError::Runtime)?;
-            let mut row = measure(&l, &mut gpu, steps, pairs);
+            let mut row = measure(&l, &mut gpu, steps, pairs)?;
             // Per-pass times from a separate timestamped run: timestamps need one
             // submission per step, which would slow the throughput figure.
             if let Ok(ctx) = GpuContext::open(AdapterChoice::AnyGpu, true) {

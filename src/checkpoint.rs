@@ -9,6 +9,7 @@
 //! name and renamed, so a checkpoint on disk is always complete.
 
 use crate::error::InputError;
+use crate::fields::{Held, FIELDS};
 use crate::model::Model;
 use crate::output::write_atomic;
 use crate::state::{Sim, State};
@@ -75,17 +76,10 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
     out.extend_from_slice(&0u32.to_le_bytes());
     out.extend_from_slice(&(json.len() as u64).to_le_bytes());
     out.extend_from_slice(&json);
-    for v in [&st.pos, &st.vel, &st.acc, &st.acc_b] {
-        push(&mut out, v);
+    // Every checkpointed field in registry order (an unheld one is empty).
+    for f in FIELDS.iter().filter(|f| f.checkpointed) {
+        push(&mut out, (f.words)(st));
     }
-    for v in [&st.rho, &st.p, &st.mass] {
-        push(&mut out, v);
-    }
-    for v in [&st.phase, &st.id] {
-        push(&mut out, v);
-    }
-    push(&mut out, &st.heat);
-    push(&mut out, &st.surface);
     out.extend_from_slice(bytemuck::bytes_of(&st.sim));
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -102,10 +96,6 @@ impl<'a> Cursor<'a> {
         let s = self.buf.get(self.at..self.at.checked_add(n)?)?;
         self.at += n;
         Some(s)
-    }
-    fn vec<T: bytemuck::Pod>(&mut self, n: usize) -> Option<Vec<T>> {
-        let bytes = self.take(n * std::mem::size_of::<T>())?;
-        Some(bytemuck::pod_collect_to_vec(bytes))
     }
     fn u32(&mut self) -> Option<u32> {
         Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
@@ -145,24 +135,18 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         .ok_or_else(|| bad("damaged header"))?;
     let n = header.particles as usize;
     let short = || bad("particle arrays shorter than the header says");
-    let state = State {
-        pos: c.vec(n).ok_or_else(short)?,
-        vel: c.vec(n).ok_or_else(short)?,
-        acc: c.vec(n).ok_or_else(short)?,
-        acc_b: c.vec(n).ok_or_else(short)?,
-        rho: c.vec(n).ok_or_else(short)?,
-        p: c.vec(n).ok_or_else(short)?,
-        mass: c.vec(n).ok_or_else(short)?,
-        phase: c.vec(n).ok_or_else(short)?,
-        id: c.vec(n).ok_or_else(short)?,
-        heat: c.vec(if header.heat { n } else { 0 }).ok_or_else(short)?,
-        surface: c
-            .vec(if header.surface { 2 * n } else { 0 })
-            .ok_or_else(short)?,
-        sim: bytemuck::pod_read_unaligned::<Sim>(
-            c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?,
-        ),
+    let held = Held {
+        heat: header.heat,
+        interface: header.surface,
     };
+    let mut state = State::default();
+    for f in FIELDS.iter().filter(|f| f.checkpointed) {
+        let count = if held.holds(f.holder) { n } else { 0 };
+        let bytes = c.take(count * f.bytes_per_particle()).ok_or_else(short)?;
+        (f.set)(&mut state, bytes);
+    }
+    state.sim =
+        bytemuck::pod_read_unaligned::<Sim>(c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?);
     if c.at != body.len() {
         return Err(bad("trailing bytes after the state"));
     }

@@ -4,7 +4,7 @@
 //! free-running step, and per pass with each pass started from the CPU's state, so
 //! that a pass's own difference is not mixed with those of the passes before it.
 
-use crate::backend::{Backend, Stage};
+use crate::backend::{Backend, DeviceLost, Stage};
 use crate::params::{Params, KIND_WALL};
 use crate::state::State;
 
@@ -223,16 +223,16 @@ fn compare_passes_isolated(
     gpu: &mut dyn Backend,
     steps: u64,
     scales: &ToleranceScales,
-) -> Vec<PassDifference> {
+) -> Result<Vec<PassDifference>, DeviceLost> {
     let pipeline = cpu.pipeline().clone();
     let mut worst: Vec<PassDifference> = Vec::new();
     for step in 1..=steps {
         for &stage in &pipeline.step {
-            let before = cpu.read_state();
+            let before = cpu.read_state()?;
             gpu.load_state(&before);
             cpu.run_stage(stage);
             gpu.run_stage(stage);
-            let (a, b) = (cpu.read_state(), gpu.read_state());
+            let (a, b) = (cpu.read_state()?, gpu.read_state()?);
             let Some(largest) = largest_differences(&a, &b, scales)
                 .into_iter()
                 .max_by(|x, y| x.relative.total_cmp(&y.relative))
@@ -253,7 +253,7 @@ fn compare_passes_isolated(
             }
         }
     }
-    worst
+    Ok(worst)
 }
 
 /// Run both backends stage by stage for `steps` steps (after priming), comparing the
@@ -263,7 +263,7 @@ pub fn compare(
     gpu: &mut dyn Backend,
     steps: u64,
     mode: &CompareMode,
-) -> CompareReport {
+) -> Result<CompareReport, DeviceLost> {
     let exact = matches!(mode, CompareMode::Exact);
     let mut report = CompareReport {
         first_difference: None,
@@ -276,19 +276,19 @@ pub fn compare(
                  step: u64,
                  stage: Stage,
                  report: &mut CompareReport|
-     -> bool {
+     -> Result<bool, DeviceLost> {
         cpu.run_stage(stage);
         gpu.run_stage(stage);
-        let (a, b) = (cpu.read_state(), gpu.read_state());
+        let (a, b) = (cpu.read_state()?, gpu.read_state()?);
         report.stages_compared += 1;
         if !exact {
-            return true;
+            return Ok(true);
         }
         if let Some(d) = first_difference(&a, &b, step, stage.name()) {
             report.first_difference = Some(d);
-            return false;
+            return Ok(false);
         }
-        true
+        Ok(true)
     };
     assert_eq!(
         cpu.pipeline(),
@@ -297,26 +297,26 @@ pub fn compare(
     );
     let pipeline = cpu.pipeline().clone();
     for &s in &pipeline.prime {
-        if !check(cpu, gpu, 0, s, &mut report) {
-            return report;
+        if !check(cpu, gpu, 0, s, &mut report)? {
+            return Ok(report);
         }
     }
     if let CompareMode::Tolerance(scales) = mode {
         // Hardware: one free-running step, then every pass on its own.
         cpu.run_steps(1);
         gpu.run_steps(1);
-        report.max_rel = largest_differences(&cpu.read_state(), &gpu.read_state(), scales);
-        report.per_pass = compare_passes_isolated(cpu, gpu, steps, scales);
-        return report;
+        report.max_rel = largest_differences(&cpu.read_state()?, &gpu.read_state()?, scales);
+        report.per_pass = compare_passes_isolated(cpu, gpu, steps, scales)?;
+        return Ok(report);
     }
     for step in 1..=steps {
         for &s in &pipeline.step {
-            if !check(cpu, gpu, step, s, &mut report) {
-                return report;
+            if !check(cpu, gpu, step, s, &mut report)? {
+                return Ok(report);
             }
         }
     }
-    report
+    Ok(report)
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod checks;
 pub mod compare;
 pub mod error;
+pub mod fields;
 pub mod gpu_layout;
 pub mod inspect;
 pub mod kernel;

@@ -520,7 +520,8 @@ fn cmd_compare(
     } else {
         compare::CompareMode::Tolerance(compare::ToleranceScales::new(&params))
     };
-    let report = compare::compare(&mut cpu, &mut gpu, steps, &mode);
+    let report = compare::compare(&mut cpu, &mut gpu, steps, &mode)
+        .map_err(|e| SpatterError::Runtime(e.to_string()))?;
     if software {
         println!(
             "compared every field after {} passes ({} steps)",

@@ -2,7 +2,7 @@
 
 use crate::backend::cpu::CpuBackend;
 use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
-use crate::backend::Backend;
+use crate::backend::{Backend, DeviceLost};
 use crate::checkpoint::{self, CheckpointSink};
 use crate::checks::{CheckResult, Checker};
 use crate::error::{InputError, SpatterError};
@@ -283,7 +283,9 @@ pub fn run(
         backend.prime();
     }
     let mut progress = Progress::new(opts.quiet);
-    let mut st = backend.read_state();
+    let mut st = backend
+        .read_state()
+        .map_err(|e| device_lost(m, out, &l.state, e))?;
     let mut last_good = st.clone();
     let mut sim = st.sim;
     let start_step = sim.step as u64;
@@ -319,7 +321,9 @@ pub fn run(
             chunk = chunk.min(n - steps_done);
         }
         steps_done += run_interruptible(backend, chunk.min(cap));
-        sim = backend.read_sim();
+        sim = backend
+            .read_sim()
+            .map_err(|e| device_lost(m, out, &last_good, e))?;
         let rate = st.len() as f64 * steps_done as f64 / start.elapsed().as_secs_f64();
         progress.update(
             opts.quiet,
@@ -341,7 +345,9 @@ pub fn run(
         if trip.is_some() || !(due.0 || due.1 || due.2) {
             continue;
         }
-        st = backend.read_state();
+        st = backend
+            .read_state()
+            .map_err(|e| device_lost(m, out, &last_good, e))?;
         trip = watchdog::scan(m, &st);
         if trip.is_some() {
             continue;
@@ -364,7 +370,8 @@ pub fn run(
     progress.finish();
     let final_state = match trip {
         Some(first) => {
-            let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first);
+            let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
+                .map_err(|e| device_lost(m, out, &last_good, e))?;
             out.frame(m, &bad).map_err(rt)?;
             out.diagnostics(m, &bad).map_err(rt)?;
             out.checkpoint(m, &good).map_err(rt)?;
@@ -372,7 +379,9 @@ pub fn run(
             bad
         }
         None => {
-            let fin = backend.read_state();
+            let fin = backend
+                .read_state()
+                .map_err(|e| device_lost(m, out, &last_good, e))?;
             out.frame(m, &fin).map_err(rt)?;
             out.diagnostics(m, &fin).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
@@ -424,18 +433,144 @@ fn replay_to_trip(
     backend: &mut dyn Backend,
     last_good: &State,
     first: Trip,
-) -> (Trip, State, State) {
+) -> Result<(Trip, State, State), DeviceLost> {
     let span = (first.step.saturating_sub(last_good.sim.step as u64) + 1) * 2;
     backend.load_state(last_good);
     let mut good = last_good.clone();
     for _ in 0..span {
         backend.run_steps(1);
-        let st = backend.read_state();
+        let st = backend.read_state()?;
         if let Some(t) = watchdog::check_sim(m, &st.sim).or_else(|| watchdog::scan(m, &st)) {
-            return (t, st, good);
+            return Ok((t, st, good));
         }
         good = st;
     }
-    let current = backend.read_state();
-    (first, current, good)
+    let current = backend.read_state()?;
+    Ok((first, current, good))
+}
+
+/// The device stopped answering mid-run: close the outputs at the last state read
+/// back (with its checkpoint, where checkpoints are on) so every file stays
+/// readable, and say where the run stopped.
+fn device_lost(m: &Model, out: &mut Outputs, last_good: &State, e: DeviceLost) -> SpatterError {
+    let mut msg = format!(
+        "{e}; the run stopped after step {} (t = {:.6e} s), where its outputs end",
+        last_good.sim.step, last_good.sim.time
+    );
+    if let Err(w) = out.checkpoint(m, last_good) {
+        msg.push_str(&format!("; the checkpoint of that state failed too: {w}"));
+    }
+    if let Err(w) = out.finish() {
+        msg.push_str(&format!("; closing the outputs failed too: {w}"));
+    }
+    SpatterError::Runtime(msg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::{Pipeline, Stage};
+    use crate::output::mcap_out::Provenance;
+
+    /// The CPU backend, except that its device is lost at the `fail_at`-th readback.
+    struct Losing {
+        inner: CpuBackend,
+        reads: u32,
+        fail_at: u32,
+    }
+
+    impl Losing {
+        fn read(&mut self) -> Result<(), DeviceLost> {
+            self.reads += 1;
+            if self.reads >= self.fail_at {
+                return Err(DeviceLost(
+                    "GPU device lost while reading back: test".into(),
+                ));
+            }
+            Ok(())
+        }
+    }
+
+    impl Backend for Losing {
+        fn describe(&self) -> String {
+            "losing".into()
+        }
+        fn is_software(&self) -> bool {
+            true
+        }
+        fn pipeline(&self) -> &Pipeline {
+            self.inner.pipeline()
+        }
+        fn run_stage(&mut self, stage: Stage) {
+            self.inner.run_stage(stage)
+        }
+        fn read_state(&mut self) -> Result<State, DeviceLost> {
+            self.read()?;
+            self.inner.read_state()
+        }
+        fn load_state(&mut self, st: &State) {
+            self.inner.load_state(st)
+        }
+        fn read_sim(&mut self) -> Result<crate::state::Sim, DeviceLost> {
+            self.read()?;
+            self.inner.read_sim()
+        }
+    }
+
+    /// A device lost mid-run ends it with an error naming the step it stopped at,
+    /// the MCAP stream closed (summary and footer) and a checkpoint of the last
+    /// state read back; no panic.
+    #[test]
+    fn a_lost_device_ends_the_run_with_its_outputs_closed() {
+        let scene = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/poiseuille_2d.toml"
+        );
+        let l = load(scene, &[]).unwrap();
+        let params = Params::new(&l.model, l.state.len() as u32);
+        let dir = std::env::temp_dir().join(format!("spatter-lost-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mcap = dir.join("run.mcap").to_string_lossy().into_owned();
+        let prov = Provenance {
+            backend: "losing",
+            command: "test",
+        };
+        let mut out = Outputs {
+            mcap: Some(McapSink::create(&mcap, &l.model, &prov).unwrap()),
+            checkpoints: Some(CheckpointSink::create(&dir.join("ckpt").to_string_lossy()).unwrap()),
+            ..Default::default()
+        };
+        let mut b = Losing {
+            inner: CpuBackend::new(params, l.state.clone()),
+            reads: 0,
+            fail_at: 4,
+        };
+        let opts = RunOptions {
+            end: EndCondition::Steps(2000),
+            quiet: true,
+            resumed: false,
+        };
+        let err = match run(&l, &mut b, &opts, &mut out) {
+            Err(SpatterError::Runtime(m)) => m,
+            Err(e) => panic!("wrong error: {e}"),
+            Ok(_) => panic!("the run went on without its device"),
+        };
+        assert!(
+            err.contains("device lost") && err.contains("stopped after step"),
+            "{err}"
+        );
+        let seen = crate::inspect::inspect(&mcap).unwrap();
+        assert!(seen.complete, "MCAP closed with summary and footer");
+        let ckpt = out
+            .last_checkpoint
+            .clone()
+            .expect("checkpoint of the last good state");
+        let c = checkpoint::load(&ckpt.to_string_lossy()).unwrap();
+        assert!(
+            c.state.sim.step > 0,
+            "a state after the first chunk was kept"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -7,7 +7,7 @@
 use crate::error::InputError;
 use crate::model::Model;
 use crate::scene::{SceneFile, ShapeDef};
-use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE, BYTES_PER_PARTICLE_HEAT};
+use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT};
 
 /// Lattice coordinates along one axis: positions and whether each is in a wall layer.
 fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
@@ -55,12 +55,11 @@ fn axis_sites_len(m: &Model, a: usize) -> f64 {
 
 /// Estimated memory of the scene in bytes.
 pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
-    let per_particle = BYTES_PER_PARTICLE
-        + if m.is_thermal() {
-            BYTES_PER_PARTICLE_HEAT
-        } else {
-            0
-        };
+    let held = crate::fields::Held {
+        heat: m.is_thermal(),
+        interface: m.needs_interface(),
+    };
+    let per_particle = crate::fields::bytes_per_particle(held) as u64 + BYTES_PER_PARTICLE_SORT;
     particles * per_particle as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
 }
 

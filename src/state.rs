@@ -67,57 +67,24 @@ impl State {
     pub fn is_empty(&self) -> bool {
         self.pos.is_empty()
     }
+    /// The compared fields this state holds, in registry order (crate::fields).
     pub fn fields(&self) -> Vec<FieldView<'_>> {
-        vec![
-            vec4_field("position", &self.pos),
-            vec4_field("velocity", &self.vel),
-            vec4_field("acceleration", &self.acc),
-            vec4_field("transport_acceleration", &self.acc_b),
-            scalar_field("density", &self.rho),
-            scalar_field("pressure", &self.p),
-            scalar_field("mass", &self.mass),
-            FieldView {
-                name: "phase",
-                components: 1,
-                words: &self.phase,
-                is_float: false,
-            },
-            FieldView {
-                name: "id",
-                components: 1,
-                words: &self.id,
-                is_float: false,
-            },
-        ]
-        .into_iter()
-        .chain((!self.heat.is_empty()).then(|| vec4_field("heat", &self.heat)))
-        .chain((!self.surface.is_empty()).then(|| vec4_field("surface", &self.surface)))
-        .collect()
+        let held = crate::fields::Held::of_state(self);
+        crate::fields::FIELDS
+            .iter()
+            .filter(|f| f.compared && held.holds(f.holder))
+            .map(|f| FieldView {
+                name: f.name,
+                components: f.components,
+                words: (f.words)(self),
+                is_float: f.is_float,
+            })
+            .collect()
     }
 }
 
-fn vec4_field<'a>(name: &'static str, v: &'a [[f32; 4]]) -> FieldView<'a> {
-    FieldView {
-        name,
-        components: 4,
-        words: bytemuck::cast_slice(v),
-        is_float: true,
-    }
-}
-
-fn scalar_field<'a>(name: &'static str, v: &'a [f32]) -> FieldView<'a> {
-    FieldView {
-        name,
-        components: 1,
-        words: bytemuck::cast_slice(v),
-        is_float: true,
-    }
-}
-
-/// Bytes the device and host hold per particle: the state above, the reorder scratch
-/// (5 vec4) and padded sort keys (2 × 8 bytes).
-pub const BYTES_PER_PARTICLE: u64 = 4 * 16 + 5 * 4 + 5 * 16 + 16;
-/// Extra bytes per particle in a heat scene: the heat vec4 and its reorder scratch.
-pub const BYTES_PER_PARTICLE_HEAT: u64 = 2 * 16;
+/// Device bytes per particle beyond its fields (crate::fields::bytes_per_particle):
+/// the sort keys, padded to a power of two (at most 2 × 8 bytes).
+pub const BYTES_PER_PARTICLE_SORT: u64 = 16;
 /// Bytes per grid cell: start and end tables.
 pub const BYTES_PER_CELL: u64 = 8;

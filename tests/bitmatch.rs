@@ -21,7 +21,7 @@ fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) {
     );
     let mut gpu = GpuBackend::new(ctx, params, &l.state, false).unwrap();
     let mut cpu = CpuBackend::new(params, l.state.clone());
-    let report = compare(&mut cpu, &mut gpu, steps, &CompareMode::Exact);
+    let report = compare(&mut cpu, &mut gpu, steps, &CompareMode::Exact).unwrap();
     if let Some(d) = report.first_difference {
         panic!(
             "{name} {sets:?}: step {} pass {} field {} particle {}: cpu {} gpu {}",
@@ -192,7 +192,8 @@ fn tolerance_mode_is_exact_on_the_software_adapter() {
         &mut gpu,
         5,
         &CompareMode::Tolerance(ToleranceScales::new(&params)),
-    );
+    )
+    .unwrap();
     let stages = spatter::backend::Pipeline::for_scene(&params, &l.state);
     assert_eq!(
         report.per_pass.len(),

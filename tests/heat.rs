@@ -249,10 +249,10 @@ fn viscous_heating_matches_couette_dissipation() {
     };
     let mut samples = vec![];
     for target in [0.1, 0.2] {
-        while (b.read_sim().time as f64) < target {
+        while (b.read_sim().unwrap().time as f64) < target {
             b.run_steps(1);
         }
-        let st = b.read_state();
+        let st = b.read_state().unwrap();
         samples.push((st.sim.time as f64, stored(&st)));
     }
     let (eta, u, len, width, nu) = (1e-3, 2.5e-5f64, 1e-3, 6e-4, 1e-6);

@@ -46,6 +46,19 @@ impl Pipeline {
     }
 }
 
+/// The device stopped answering: lost, or a readback that never completed. The
+/// run that meets it closes its outputs at the last state it read back.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DeviceLost(pub String);
+
+impl std::fmt::Display for DeviceLost {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl std::error::Error for DeviceLost {}
+
 pub trait Backend {
     /// "cpu (2 threads)" or "gpu: <adapter> (<driver>)".
     fn describe(&self) -> String;
@@ -68,11 +81,11 @@ pub trait Backend {
             self.run_stage(s);
         }
     }
-    fn read_state(&mut self) -> State;
+    fn read_state(&mut self) -> Result<State, DeviceLost>;
     /// Replace the device state with `st` (same particle count): resume from a
     /// checkpoint, or rewind to the last good state when the watchdog trips.
     fn load_state(&mut self, st: &State);
-    fn read_sim(&mut self) -> Sim;
+    fn read_sim(&mut self) -> Result<Sim, DeviceLost>;
     /// Milliseconds per pass summed since the last call, where the backend measures them.
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
         Vec::new()

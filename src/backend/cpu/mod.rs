@@ -13,7 +13,7 @@ mod terms;
 mod timestep;
 mod wall;
 
-use super::{Backend, Pipeline, Stage};
+use super::{Backend, DeviceLost, Pipeline, Stage};
 use crate::params::Params;
 use crate::state::{Sim, State};
 use std::time::Instant;
@@ -127,11 +127,11 @@ impl Backend for CpuBackend {
             None => self.times.push((name, ms)),
         }
     }
-    fn read_state(&mut self) -> State {
-        self.st.clone()
+    fn read_state(&mut self) -> Result<State, DeviceLost> {
+        Ok(self.st.clone())
     }
-    fn read_sim(&mut self) -> Sim {
-        self.st.sim
+    fn read_sim(&mut self) -> Result<Sim, DeviceLost> {
+        Ok(self.st.sim)
     }
     fn load_state(&mut self, st: &State) {
         assert_eq!(

@@ -17,6 +17,10 @@
 //! ones that were measured on hardware. The Rust twin is
 //! `backend::cpu::neighbors::for_each_neighbor`: same cells, same order.
 
+use crate::backend::entry_points;
+use crate::params::Params;
+use std::collections::HashMap;
+
 /// Library files, in the order they are composed (each after what it uses).
 const LIBS: [(&str, &str); 7] = [
     ("params", include_str!("../../../shaders/lib/params.wgsl")),
@@ -166,6 +170,72 @@ pub fn expand_walks(src: &str) -> Result<String, String> {
         s.push('\n');
     }
     Ok(s)
+}
+
+/// Each pass's complete WGSL source (its libraries first, neighbour walks
+/// expanded), by shader file name. Public so that a test can validate them without
+/// an adapter.
+pub fn shader_sources() -> Vec<(&'static str, String)> {
+    PASSES
+        .iter()
+        .map(|(name, src)| {
+            let full = compose(name, src).unwrap_or_else(|e| panic!("shaders/{name}.wgsl: {e}"));
+            (*name, full)
+        })
+        .collect()
+}
+
+pub fn build_pipelines(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    sort_layout: &wgpu::BindGroupLayout,
+    params: &Params,
+) -> HashMap<&'static str, wgpu::ComputePipeline> {
+    let modules: HashMap<&str, wgpu::ShaderModule> = shader_sources()
+        .into_iter()
+        .map(|(name, source)| {
+            let m = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            (name, m)
+        })
+        .collect();
+    let plain = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("particles"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let sorting = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("particles + sort stage"),
+        bind_group_layouts: &[Some(layout), Some(sort_layout)],
+        immediate_size: 0,
+    });
+    entry_points()
+        .into_iter()
+        .map(|(entry, file)| {
+            let pl = if entry.starts_with("bitonic") {
+                &sorting
+            } else {
+                &plain
+            };
+            // The pass's switchable pair terms: a term the scene does not use is
+            // compiled out here, not skipped per pair.
+            let switches = crate::backend::terms::switches(file, params);
+            let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(pl),
+                module: &modules[file],
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &switches,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+            (entry, p)
+        })
+        .collect()
 }
 
 #[cfg(test)]

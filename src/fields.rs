@@ -1,0 +1,223 @@
+//! The per-particle field registry: one row per array of `State`, and everything
+//! that handles fields generically reads it: GPU allocation, upload, readback and
+//! the reorder copies (backend::gpu), checkpoints (checkpoint.rs), `compare`
+//! (State::fields) and the memory estimate. The CPU passes use the arrays by name.
+//!
+//! Adding a field: its array in `State`, one row here, its WGSL binding in
+//! shaders/lib/bindings.wgsl (and its scratch's when it is reordered) and in
+//! `backend::gpu::BINDINGS`; tests/fields.rs checks that the rows, the bindings and
+//! the WGSL agree.
+
+use crate::state::State;
+
+/// Which scenes hold a field (elsewhere its array is empty and its GPU buffer a
+/// 16-byte placeholder).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Holder {
+    Every,
+    /// Scenes with temperature.
+    Heat,
+    /// Scenes with interface normals.
+    Interface,
+}
+
+/// The scene's holders, from the pipeline's features.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Held {
+    pub heat: bool,
+    pub interface: bool,
+}
+
+impl Held {
+    pub fn holds(&self, h: Holder) -> bool {
+        match h {
+            Holder::Every => true,
+            Holder::Heat => self.heat,
+            Holder::Interface => self.interface,
+        }
+    }
+    /// What a state holds (its optional arrays are empty when not held).
+    pub fn of_state(st: &State) -> Held {
+        Held {
+            heat: !st.heat.is_empty(),
+            interface: !st.surface.is_empty(),
+        }
+    }
+}
+
+pub struct FieldDef {
+    /// Name in `compare` reports.
+    pub name: &'static str,
+    /// Its WGSL storage binding.
+    pub binding: &'static str,
+    /// The binding of its reorder scratch: the neighbour pass sorts it with the
+    /// particles. None: recomputed after every sort (density, pressure, normals).
+    pub scratch: Option<&'static str>,
+    /// 32-bit words per entry (4 for a vec4).
+    pub components: usize,
+    /// Entries per particle (2 for `surface`: normal and δ, then the Shepard sum).
+    pub per_particle: usize,
+    pub is_float: bool,
+    pub holder: Holder,
+    /// In checkpoints (everything needed to continue bit-identically).
+    pub checkpointed: bool,
+    /// Compared field by field by `spatter compare` and the bit-match tests.
+    pub compared: bool,
+    /// The array as 32-bit words.
+    pub words: fn(&State) -> &[u32],
+    /// Replace the array from little-endian bytes (length checked by the caller).
+    pub set: fn(&mut State, &[u8]),
+}
+
+impl FieldDef {
+    pub fn bytes_per_particle(&self) -> usize {
+        4 * self.components * self.per_particle
+    }
+}
+
+/// Declares one field row from its `State` array.
+macro_rules! field {
+    ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
+     $per:literal, $float:literal, $holder:expr) => {
+        FieldDef {
+            name: $name,
+            binding: $binding,
+            scratch: $scratch,
+            components: $components,
+            per_particle: $per,
+            is_float: $float,
+            holder: $holder,
+            checkpointed: true,
+            compared: true,
+            words: |s| bytemuck::cast_slice(&s.$array),
+            set: |s, b| s.$array = bytemuck::pod_collect_to_vec(b),
+        }
+    };
+}
+
+/// Every per-particle field, in checkpoint and `compare` order.
+pub const FIELDS: [FieldDef; 11] = [
+    field!(
+        "position",
+        pos,
+        "pos",
+        Some("s_pos"),
+        4,
+        1,
+        true,
+        Holder::Every
+    ),
+    field!(
+        "velocity",
+        vel,
+        "vel",
+        Some("s_vel"),
+        4,
+        1,
+        true,
+        Holder::Every
+    ),
+    field!(
+        "acceleration",
+        acc,
+        "acc",
+        Some("s_acc"),
+        4,
+        1,
+        true,
+        Holder::Every
+    ),
+    field!(
+        "transport_acceleration",
+        acc_b,
+        "acc_b",
+        Some("s_acc_b"),
+        4,
+        1,
+        true,
+        Holder::Every
+    ),
+    field!("density", rho, "rho", None, 1, 1, true, Holder::Every),
+    field!("pressure", p, "press", None, 1, 1, true, Holder::Every),
+    field!(
+        "mass",
+        mass,
+        "mass",
+        Some("s_mass"),
+        1,
+        1,
+        true,
+        Holder::Every
+    ),
+    field!(
+        "phase",
+        phase,
+        "phase",
+        Some("s_phase"),
+        1,
+        1,
+        false,
+        Holder::Every
+    ),
+    field!("id", id, "pid", Some("s_pid"), 1, 1, false, Holder::Every),
+    field!(
+        "heat",
+        heat,
+        "heat",
+        Some("s_heat"),
+        4,
+        1,
+        true,
+        Holder::Heat
+    ),
+    field!(
+        "surface",
+        surface,
+        "surface",
+        None,
+        4,
+        2,
+        true,
+        Holder::Interface
+    ),
+];
+
+/// Bytes per particle the fields of a scene take on the device, scratch included.
+pub fn bytes_per_particle(held: Held) -> usize {
+    FIELDS
+        .iter()
+        .filter(|f| held.holds(f.holder))
+        .map(|f| f.bytes_per_particle() * if f.scratch.is_some() { 2 } else { 1 })
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_read_and_write_their_own_array() {
+        let mut st = State::default();
+        for (k, f) in FIELDS.iter().enumerate() {
+            let words: Vec<u32> = (0..(f.components * f.per_particle) as u32)
+                .map(|w| 100 * k as u32 + w)
+                .collect();
+            (f.set)(&mut st, bytemuck::cast_slice(&words));
+            assert_eq!((f.words)(&st), &words[..], "{}", f.name);
+        }
+        // Each row wrote a different array: none was overwritten by a later one.
+        for (k, f) in FIELDS.iter().enumerate() {
+            assert_eq!((f.words)(&st)[0], 100 * k as u32, "{}", f.name);
+        }
+    }
+
+    #[test]
+    fn names_and_bindings_are_unique() {
+        for (k, f) in FIELDS.iter().enumerate() {
+            for g in &FIELDS[k + 1..] {
+                assert_ne!(f.name, g.name);
+                assert_ne!(f.binding, g.binding);
+            }
+        }
+    }
+}

@@ -1,4 +1,5 @@
 // uses: params bindings consts kernel grid phase
+// writes: acc acc_b
 // Pressure + viscous forces F22 (23), transport-velocity background pressure
 // (Adami 2013), interface viscosity F22 (31), viscous heating and gravity: one
 // sweep over the neighbours, each pair term a function in shaders/terms/ (the

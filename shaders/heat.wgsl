@@ -1,4 +1,5 @@
 // uses: params bindings consts kernel grid phase math
+// writes: acc acc_b heat phase vel
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 

@@ -1,4 +1,5 @@
 // uses: params bindings consts grid phase
+// writes: pos vel
 // Velocity Verlet with transport velocity. Twin of src/backend/cpu/integrate.rs.
 
 @compute @workgroup_size(64)

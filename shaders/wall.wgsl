@@ -1,4 +1,5 @@
 // uses: params bindings kernel grid phase
+// writes: rho press vel
 // Generalized wall boundary (Adami, Hu & Adams 2012): each wall particle gathers
 // pressure and velocity from its fluid neighbours. Twin of src/backend/cpu/wall.rs.
 

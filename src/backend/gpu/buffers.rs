@@ -1,4 +1,6 @@
-//! Device buffers and the one bind group every pass uses. The per-particle fields
+//! Device buffers and the bind groups over them: one per pass file, the same
+//! buffers at the same bindings, each pass's read-only ones marked read-only (the
+//! pass's `// writes:` line, backend::gpu::shaders). The per-particle fields
 //! come from the field registry (crate::fields); the rest is the cell table, the
 //! sort keys, per-step scalars and scene-specific tables. `BINDINGS` names the
 //! buffer at each binding of shaders/lib/bindings.wgsl (tests/fields.rs reads that
@@ -190,18 +192,22 @@ impl Buffers {
     }
 }
 
-/// The main layout (group 0: the parameter block, then storage buffers) and the
-/// sort stage's (group 1: one uniform with a dynamic offset).
-pub fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
-    let entries: Vec<wgpu::BindGroupLayoutEntry> = (0..BINDINGS.len() as u32)
-        .map(|b| wgpu::BindGroupLayoutEntry {
-            binding: b,
+/// A pass's layout of group 0: the parameter block, then every storage buffer,
+/// read-only where the pass only reads it (shaders::read_only_bindings).
+pub fn pass_layout(device: &wgpu::Device, pass: &str, read_only: &[&str]) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = BINDINGS
+        .iter()
+        .enumerate()
+        .map(|(b, name)| wgpu::BindGroupLayoutEntry {
+            binding: b as u32,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: if b == 0 {
                     wgpu::BufferBindingType::Uniform
                 } else {
-                    wgpu::BufferBindingType::Storage { read_only: false }
+                    wgpu::BufferBindingType::Storage {
+                        read_only: read_only.contains(name),
+                    }
                 },
                 has_dynamic_offset: false,
                 min_binding_size: None,
@@ -209,11 +215,15 @@ pub fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroup
             count: None,
         })
         .collect();
-    let main = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("particles"),
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(pass),
         entries: &entries,
-    });
-    let sort = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+    })
+}
+
+/// The sort stage's layout (group 1: one uniform with a dynamic offset).
+pub fn sort_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("sort stage"),
         entries: &[wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -225,8 +235,7 @@ pub fn layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroup
             },
             count: None,
         }],
-    });
-    (main, sort)
+    })
 }
 
 pub fn main_bind_group(

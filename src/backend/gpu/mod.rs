@@ -38,7 +38,8 @@ pub struct GpuBackend {
     n_pad: u32,
     sort_steps: Vec<SortStep>,
     buf: Buffers,
-    bind: wgpu::BindGroup,
+    /// Group 0 per pass file (same buffers, each pass's read-only ones marked).
+    binds: HashMap<&'static str, wgpu::BindGroup>,
     sort_bind: wgpu::BindGroup,
     pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
     profiler: Option<Profiler>,
@@ -63,12 +64,22 @@ impl GpuBackend {
         }
         let stages = sort_stages(n_pad);
         let buf = Buffers::new(device, &params, n, n_pad, held, &stages);
-        let (layout, sort_layout) = buffers::layouts(device);
-        let bind = buffers::main_bind_group(device, &layout, &buf);
-        let sort_bind = buffers::sort_bind_group(device, &sort_layout, &buf);
         // A shader the driver rejects is an error of this run, not a panic.
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipelines = shaders::build_pipelines(device, &layout, &sort_layout, &params);
+        let layouts: HashMap<&'static str, wgpu::BindGroupLayout> = shaders::PASSES
+            .iter()
+            .map(|(file, src)| {
+                let read_only = shaders::read_only_bindings(src);
+                (*file, buffers::pass_layout(device, file, &read_only))
+            })
+            .collect();
+        let binds = layouts
+            .iter()
+            .map(|(file, layout)| (*file, buffers::main_bind_group(device, layout, &buf)))
+            .collect();
+        let sort_layout = buffers::sort_layout(device);
+        let sort_bind = buffers::sort_bind_group(device, &sort_layout, &buf);
+        let pipelines = shaders::build_pipelines(device, &layouts, &sort_layout, &params);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(format!("GPU pipeline creation failed: {e}"));
         }
@@ -89,7 +100,7 @@ impl GpuBackend {
             n_pad,
             sort_steps: stages,
             buf,
-            bind,
+            binds,
             sort_bind,
             pipelines,
             profiler,
@@ -130,14 +141,16 @@ impl GpuBackend {
         stage: Stage,
         idx: u32,
     ) -> wgpu::ComputePass<'e> {
-        self.begin_pass_marked(enc, stage.name(), idx, true, true)
+        self.begin_pass_marked(enc, stage.name(), stage.pass(), idx, true, true)
     }
 
-    /// A compute pass writing the stage's begin and/or end timestamp when profiling.
+    /// A compute pass of WGSL file `file` (its bind group), writing the stage's
+    /// begin and/or end timestamp when profiling.
     fn begin_pass_marked<'e>(
         &self,
         enc: &'e mut wgpu::CommandEncoder,
         label: &str,
+        file: &str,
         idx: u32,
         begin: bool,
         end: bool,
@@ -147,7 +160,7 @@ impl GpuBackend {
             label: Some(label),
             timestamp_writes,
         });
-        pass.set_bind_group(0, &self.bind, &[]);
+        pass.set_bind_group(0, &self.binds[file], &[]);
         pass
     }
 
@@ -166,7 +179,8 @@ impl GpuBackend {
 
     fn encode_neighbors(&self, enc: &mut wgpu::CommandEncoder, idx: u32) {
         {
-            let mut pass = self.begin_pass_marked(enc, "neighbors.sort", idx, true, false);
+            let mut pass =
+                self.begin_pass_marked(enc, "neighbors.sort", "neighbors", idx, true, false);
             self.dispatch(&mut pass, "cell_keys", Work::SortKeys);
             for (s, step) in self.sort_steps.iter().enumerate() {
                 let (name, groups) = match step {
@@ -185,7 +199,8 @@ impl GpuBackend {
         enc.clear_buffer(&b.cell_start, 0, None);
         enc.clear_buffer(&b.cell_end, 0, None);
         enc.clear_buffer(&b.cell_fluid, 0, None);
-        let mut pass = self.begin_pass_marked(enc, "neighbors.cell_bounds", idx, false, true);
+        let mut pass =
+            self.begin_pass_marked(enc, "neighbors.cell_bounds", "neighbors", idx, false, true);
         self.dispatch(&mut pass, "cell_bounds", Work::Particles);
     }
 

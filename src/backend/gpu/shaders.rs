@@ -59,6 +59,56 @@ fn uses(src: &str) -> Vec<&str> {
         .unwrap_or_default()
 }
 
+/// The storage buffers a pass writes, from its `// writes:` line (None: no such
+/// line, every buffer stays read_write).
+fn writes(src: &str) -> Option<Vec<&str>> {
+    src.lines()
+        .take(4)
+        .find_map(|l| l.strip_prefix("// writes:"))
+        .map(|l| l.split_whitespace().collect())
+}
+
+/// The bindings library with every storage buffer the pass does not write declared
+/// `read` (atomics stay read_write, as WGSL requires). naga rejects a store to a
+/// `read` buffer, so a `// writes:` line that misses one fails tests/shaders.rs.
+fn restrict_access(bindings: &str, written: &[&str]) -> String {
+    let mut out = String::with_capacity(bindings.len());
+    for line in bindings.lines() {
+        let name = line
+            .split("var<storage, read_write> ")
+            .nth(1)
+            .and_then(|rest| rest.split(':').next());
+        match name {
+            Some(n) if !written.contains(&n) && !line.contains("atomic<") => {
+                out.push_str(&line.replacen("read_write", "read", 1))
+            }
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The bindings a pass reads only (declared `read` in its composed source): its
+/// bind group layout must say so too.
+pub fn read_only_bindings(pass: &str) -> Vec<&'static str> {
+    let bindings = LIBS
+        .iter()
+        .find(|(n, _)| *n == "bindings")
+        .expect("bindings")
+        .1;
+    let Some(w) = writes(pass) else {
+        return Vec::new();
+    };
+    bindings
+        .lines()
+        .filter(|l| !l.contains("atomic<"))
+        .filter_map(|l| l.split("var<storage, read_write> ").nth(1))
+        .filter_map(|rest| rest.split(':').next())
+        .filter(|n| !w.contains(n))
+        .collect()
+}
+
 /// `wanted` and everything it uses, in LIBS order.
 fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
     let mut need = [false; LIBS.len()];
@@ -76,12 +126,17 @@ fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
     Ok((0..LIBS.len()).filter(|&k| need[k]).collect())
 }
 
-/// A pass's complete source: its libraries, its pair terms (backend::terms), then
-/// the pass with every neighbour walk expanded.
+/// A pass's complete source: its libraries (storage buffers it does not write
+/// declared `read`), its pair terms (backend::terms), then the pass with every
+/// neighbour walk expanded.
 pub fn compose(name: &str, pass: &str) -> Result<String, String> {
     let mut out = String::new();
+    let written = writes(pass);
     for k in resolve(&uses(pass))? {
-        out.push_str(LIBS[k].1);
+        match (LIBS[k].0, &written) {
+            ("bindings", Some(w)) => out.push_str(&restrict_access(LIBS[k].1, w)),
+            _ => out.push_str(LIBS[k].1),
+        }
         out.push('\n');
     }
     for term in crate::backend::terms::wgsl_for(name) {
@@ -187,7 +242,7 @@ pub fn shader_sources() -> Vec<(&'static str, String)> {
 
 pub fn build_pipelines(
     device: &wgpu::Device,
-    layout: &wgpu::BindGroupLayout,
+    layouts: &HashMap<&'static str, wgpu::BindGroupLayout>,
     sort_layout: &wgpu::BindGroupLayout,
     params: &Params,
 ) -> HashMap<&'static str, wgpu::ComputePipeline> {
@@ -201,30 +256,26 @@ pub fn build_pipelines(
             (name, m)
         })
         .collect();
-    let plain = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("particles"),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
-    let sorting = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("particles + sort stage"),
-        bind_group_layouts: &[Some(layout), Some(sort_layout)],
-        immediate_size: 0,
-    });
     entry_points()
         .into_iter()
         .map(|(entry, file)| {
-            let pl = if entry.starts_with("bitonic") {
-                &sorting
+            // The sort's dispatches also bind their stage uniform (group 1).
+            let groups: Vec<Option<&wgpu::BindGroupLayout>> = if entry.starts_with("bitonic") {
+                vec![Some(&layouts[file]), Some(sort_layout)]
             } else {
-                &plain
+                vec![Some(&layouts[file])]
             };
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry),
+                bind_group_layouts: &groups,
+                immediate_size: 0,
+            });
             // The pass's switchable pair terms: a term the scene does not use is
             // compiled out here, not skipped per pair.
             let switches = crate::backend::terms::switches(file, params);
             let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
-                layout: Some(pl),
+                layout: Some(&pl),
                 module: &modules[file],
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
@@ -266,6 +317,18 @@ mod tests {
         assert!(expand_walks("    #for_each_neighbor(ci, zr, j) {\n        x;\n").is_err());
         assert!(expand_walks("    #for_each_neighbor(ci, j) {\n    }\n").is_err());
         assert!(compose("x", "// uses: params nonsense\n").is_err());
+    }
+
+    #[test]
+    fn buffers_a_pass_does_not_write_are_read_only() {
+        let src = compose("x", "// uses: bindings\n// writes: acc\nfn f() {}\n").unwrap();
+        assert!(src.contains("var<storage, read_write> acc: array<vec4<f32>>;"));
+        assert!(src.contains("var<storage, read> pos: array<vec4<f32>>;"));
+        // Atomics must stay read_write.
+        assert!(src.contains("var<storage, read_write> cell_fluid: array<atomic<u32>>;"));
+        // Without a writes line nothing changes.
+        let all = compose("x", "// uses: bindings\nfn f() {}\n").unwrap();
+        assert!(all.contains("var<storage, read_write> pos:"));
     }
 
     #[test]

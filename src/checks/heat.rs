@@ -2,6 +2,7 @@
 //! semi-infinite solid (erf), steady conduction through two layers, and enthalpy
 //! conservation in an adiabatic box.
 
+use super::{Check, Verdict};
 use crate::model::Model;
 use crate::state::State;
 
@@ -392,6 +393,96 @@ pub fn rosenthal(m: &Model, st: &State) -> (String, f64, Vec<String>) {
     }
     details.push(format!("  {used} surface particles compared"));
     (metric, worst, details)
+}
+
+/// Conduction into a semi-infinite solid (erf profile).
+pub struct Conduction1d;
+
+impl Check for Conduction1d {
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        conduction_1d(m, st).into()
+    }
+}
+
+/// Steady conduction through two layers meeting at `interface`.
+pub struct TwoMaterials {
+    pub interface: f64,
+}
+
+impl Check for TwoMaterials {
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        two_materials(m, st, self.interface).into()
+    }
+}
+
+/// Total enthalpy of an insulated box against its first sample.
+#[derive(Default)]
+pub struct Adiabatic {
+    initial: Option<f64>,
+}
+
+impl Check for Adiabatic {
+    fn observe(&mut self, m: &Model, st: &State) {
+        self.initial.get_or_insert_with(|| total_enthalpy(m, st));
+    }
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        adiabatic(m, st, self.initial.unwrap_or(f64::NAN)).into()
+    }
+}
+
+/// Melting front against Stefan's solution, sample by sample.
+#[derive(Default)]
+pub struct Stefan {
+    /// (t, simulated front, exact front) per sample, and the header line.
+    fronts: Vec<(f64, f64, f64)>,
+    info: String,
+}
+
+impl Check for Stefan {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let t = st.sim.time as f64;
+        if let Some((front, exact, info)) = stefan_fronts(m, st) {
+            if self.fronts.last().is_none_or(|f| f.0 < t) {
+                self.fronts.push((t, front, exact));
+            }
+            self.info = info;
+        }
+    }
+    fn verdict(&mut self, m: &Model, _st: &State) -> Verdict {
+        stefan_1d(m, &self.fronts, &self.info).into()
+    }
+}
+
+/// Quasi-steady temperature around a moving source (Rosenthal).
+pub struct Rosenthal;
+
+impl Check for Rosenthal {
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        rosenthal(m, st).into()
+    }
+}
+
+/// Laser energy balance: absorbed power against the enthalpy gained plus the heat
+/// that left through free surfaces.
+#[derive(Default)]
+pub struct LaserEnergy {
+    initial: Option<f64>,
+    /// (t, heat leaving through free surfaces) per sample.
+    losses: Vec<(f64, f64)>,
+}
+
+impl Check for LaserEnergy {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let t = st.sim.time as f64;
+        self.initial.get_or_insert_with(|| total_enthalpy(m, st));
+        let (evap, rad) = crate::output::surface_loss_power(m, st);
+        if self.losses.last().is_none_or(|l| l.0 < t) {
+            self.losses.push((t, evap + rad));
+        }
+    }
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        laser_energy(m, st, self.initial.unwrap_or(f64::NAN), &self.losses).into()
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,200 @@
+//! Validation checks against reference solutions (PHYSICS.md §9). A scene's `[check]`
+//! section picks one; the run feeds it state samples and prints its verdict.
+//!
+//! One file per kind, each a `Check`: flow.rs (hydrostatic pressure, Poiseuille
+//! and Couette profiles), dam_break.rs (surge front against the experiments),
+//! two_layer.rs (liquid under gas), compression.rs (liquid density), heat.rs
+//! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy).
+
+mod compression;
+mod dam_break;
+mod flow;
+mod heat;
+mod two_layer;
+
+pub use dam_break::{fit_release_delay, ReleaseDelayFit};
+
+use crate::model::Model;
+use crate::scene::{CheckDef, CheckKind, PhaseKind};
+use crate::state::State;
+
+pub struct CheckResult {
+    pub name: String,
+    pub metric: String,
+    pub value: f64,
+    pub tolerance: f64,
+    pub pass: bool,
+    /// Extra lines (e.g. sampled values) printed before the verdict.
+    pub details: Vec<String>,
+    /// Named secondary figures a check measures besides its verdict (e.g. the dam
+    /// break's fitted release delay), for tests and scripts.
+    pub figures: Vec<(String, f64)>,
+}
+
+impl CheckResult {
+    pub fn line(&self) -> String {
+        format!(
+            "check {}: {} = {:.4e} (tolerance {:.4e}) {}",
+            self.name,
+            self.metric,
+            self.value,
+            self.tolerance,
+            if self.pass { "PASS" } else { "FAIL" }
+        )
+    }
+}
+
+/// What a check concludes: its metric and value (held against the scene's
+/// tolerance), lines printed before the verdict, and named secondary figures.
+pub struct Verdict {
+    pub metric: String,
+    pub value: f64,
+    pub details: Vec<String>,
+    pub figures: Vec<(String, f64)>,
+}
+
+impl From<(String, f64, Vec<String>)> for Verdict {
+    fn from((metric, value, details): (String, f64, Vec<String>)) -> Self {
+        Verdict {
+            metric,
+            value,
+            details,
+            figures: Vec::new(),
+        }
+    }
+}
+
+/// One kind of validation check.
+pub trait Check {
+    /// A state sample during the run (every output frame, and the final state).
+    fn observe(&mut self, _m: &Model, _st: &State) {}
+    /// The verdict on the final state and the samples seen.
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict;
+}
+
+/// The scene's check, watching the run: `observe` at every sample, `finish` at the end.
+pub struct Checker {
+    kind: CheckKind,
+    tolerance: f64,
+    check: Box<dyn Check>,
+}
+
+impl Checker {
+    pub fn new(m: &Model) -> Option<Checker> {
+        m.check.as_ref().map(|c| Checker {
+            kind: c.kind,
+            tolerance: c.tolerance,
+            check: make(m, c),
+        })
+    }
+
+    pub fn observe(&mut self, m: &Model, st: &State) {
+        self.check.observe(m, st);
+    }
+
+    pub fn finish(&mut self, m: &Model, st: &State) -> CheckResult {
+        self.check.observe(m, st);
+        let v = self.check.verdict(m, st);
+        CheckResult {
+            name: self.kind.name().into(),
+            metric: v.metric,
+            value: v.value,
+            tolerance: self.tolerance,
+            pass: v.value.is_finite() && v.value <= self.tolerance,
+            details: v.details,
+            figures: v.figures,
+        }
+    }
+}
+
+/// The check a `[check]` section asks for.
+fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
+    match c.kind {
+        CheckKind::Hydrostatic => Box::new(flow::Hydrostatic {
+            surface: c.surface.unwrap_or(f64::NAN),
+            exclude: c.exclude_depth.unwrap_or(3.0 * m.h),
+        }),
+        CheckKind::Poiseuille => Box::new(flow::Profile::Poiseuille),
+        CheckKind::Couette => Box::new(flow::Profile::Couette),
+        CheckKind::DamBreakFront => Box::new(dam_break::DamBreak::new(
+            c.column_width.unwrap_or(f64::NAN),
+            c.experiment,
+        )),
+        CheckKind::TwoLayer => Box::new(two_layer::TwoLayer::default()),
+        CheckKind::Compression => Box::new(compression::Compression::default()),
+        CheckKind::Conduction1d => Box::new(heat::Conduction1d),
+        CheckKind::ConductionTwoMaterials => Box::new(heat::TwoMaterials {
+            interface: c.surface.unwrap_or(f64::NAN),
+        }),
+        CheckKind::Adiabatic => Box::new(heat::Adiabatic::default()),
+        CheckKind::Stefan1d => Box::new(heat::Stefan::default()),
+        CheckKind::Rosenthal => Box::new(heat::Rosenthal),
+        CheckKind::LaserEnergy => Box::new(heat::LaserEnergy::default()),
+    }
+}
+
+/// Particle in absolute coordinates with its phase kind.
+pub(super) struct P {
+    pub x: [f64; 3],
+    pub v: [f64; 3],
+    p: f64,
+    kind: PhaseKind,
+}
+
+pub(super) fn particles<'a>(m: &'a Model, st: &'a State) -> impl Iterator<Item = P> + 'a {
+    (0..st.len()).map(move |i| {
+        let x = st.pos[i];
+        let v = st.vel[i];
+        P {
+            x: [
+                x[0] as f64 + m.origin[0],
+                x[1] as f64 + m.origin[1],
+                x[2] as f64 + m.origin[2],
+            ],
+            v: [v[0] as f64, v[1] as f64, v[2] as f64],
+            p: st.p[i] as f64,
+            kind: m.phases[st.phase[i] as usize].kind,
+        }
+    })
+}
+
+pub(super) fn g_mag(m: &Model) -> f64 {
+    m.gravity.iter().map(|g| g * g).sum::<f64>().sqrt()
+}
+
+pub(super) fn liquid_rho0(m: &Model) -> f64 {
+    m.phases
+        .iter()
+        .find(|p| p.kind == PhaseKind::Liquid)
+        .map(|p| p.rho0)
+        .unwrap_or(1.0)
+}
+
+pub(super) fn linear_fit_at_zero(pts: &[(f64, f64)]) -> f64 {
+    let n = pts.len() as f64;
+    if n < 2.0 {
+        return f64::NAN;
+    }
+    let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxx, sxy) = pts.iter().fold((0.0, 0.0), |a, p| {
+        (a.0 + (p.0 - mx) * (p.0 - mx), a.1 + (p.0 - mx) * (p.1 - my))
+    });
+    let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    my - slope * mx
+}
+
+/// Linear interpolation in a table sorted by x, held at the end values outside it.
+/// Repeated x (a run's final state is observed twice) are skipped.
+pub(super) fn interpolate(table: &[(f64, f64)], x: f64) -> f64 {
+    if x <= table[0].0 {
+        return table[0].1;
+    }
+    for w in table.windows(2) {
+        if x <= w[1].0 && w[1].0 > w[0].0 {
+            let f = (x - w[0].0) / (w[1].0 - w[0].0);
+            return w[0].1 + f * (w[1].1 - w[0].1);
+        }
+    }
+    table[table.len() - 1].1
+}

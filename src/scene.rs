@@ -393,7 +393,7 @@ pub struct CheckDef {
     pub exclude_depth: Option<f64>,
 }
 
-/// Surge-front data for a column of width L and height 2L (checks.rs holds the tables).
+/// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum DamBreakExperiment {

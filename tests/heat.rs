@@ -208,7 +208,7 @@ fn radiation_loss_balances_and_matches_the_flat_surface_flux() {
 }
 
 /// Issue 4: a moving source over a plate, conduction only, against Rosenthal's
-/// quasi-steady solution (window and normalisation in heat_checks::rosenthal).
+/// quasi-steady solution (window and normalisation in checks/heat.rs, rosenthal).
 #[test]
 fn rosenthal_scan_line_within_5_percent() {
     assert_check("rosenthal_2d", &[], 0.05);

@@ -170,7 +170,7 @@ fn dam_break_front_within_10_percent() {
 /// So the experiment's clock gets one fitted start delay ΔT in
 /// (0, 0.5) of T (up to 43 / 27 ms in their columns), and the front must then be
 /// within the 10% of every data point with T <= 2.5. A front at the wrong
-/// speed fails whatever the delay (unit test in checks.rs); the unshifted criterion
+/// speed fails whatever the delay (unit test in checks/dam_break.rs); the unshifted criterion
 /// stays in the ignored test above. Measured on the CPU (2D, dx = 2.5 mm): K&O
 /// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
 /// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse): 7.5% at

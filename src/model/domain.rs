@@ -1,0 +1,188 @@
+//! The domain: its box and periodic axes, walls and open sides, the cell grid, and
+//! the axis a hydrostatic start stacks the fluid along.
+
+use super::*;
+
+pub(super) fn domain_box(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+) -> Result<([f64; 3], [f64; 3], [bool; 3]), InputError> {
+    let lo = cx.vector("domain.min", &scene.domain.min, dim)?;
+    let hi = cx.vector("domain.max", &scene.domain.max, dim)?;
+    for a in 0..dim as usize {
+        if hi[a] <= lo[a] {
+            return Err(cx.err(
+                "domain.max",
+                format!("must exceed domain.min on every axis (axis {a})"),
+            ));
+        }
+    }
+    let mut periodic = [false; 3];
+    if !scene.domain.periodic.is_empty() {
+        if scene.domain.periodic.len() != dim as usize {
+            return Err(cx.err("domain.periodic", format!("needs {dim} entries")));
+        }
+        periodic[..dim as usize].copy_from_slice(&scene.domain.periodic);
+    }
+    Ok((lo, hi, periodic))
+}
+
+/// The axis a hydrostatic start stacks the fluid along: gravity must point along
+/// exactly one axis, and that axis must not be periodic (no top to hang from).
+pub(super) fn hydrostatic_axis(
+    cx: &Ctx,
+    gravity: [f64; 3],
+    periodic: [bool; 3],
+) -> Result<usize, InputError> {
+    let key = "simulation.initial_pressure";
+    let axes: Vec<usize> = (0..3).filter(|&a| gravity[a] != 0.0).collect();
+    let &[a] = axes.as_slice() else {
+        return Err(cx.err(
+            key,
+            format!(
+                "\"hydrostatic\" needs simulation.gravity along exactly one axis (got {gravity:?})"
+            ),
+        ));
+    };
+    if periodic[a] {
+        return Err(cx.err(
+            key,
+            format!("\"hydrostatic\" needs a non-periodic gravity axis (axis {a} is periodic)"),
+        ));
+    }
+    Ok(a)
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn cell_grid(
+    cx: &Ctx,
+    dim: u32,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    periodic: [bool; 3],
+    support: f64,
+    dx: f64,
+    wall_layers: u32,
+) -> Result<([f64; 3], [u32; 3], [f64; 3]), InputError> {
+    let mut origin = [0.0; 3];
+    let mut grid = [1u32; 3];
+    let mut cell = [1.0; 3];
+    for a in 0..dim as usize {
+        let len = hi[a] - lo[a];
+        if periodic[a] {
+            // Cells tile the period exactly so wrapped neighbours land in whole cells.
+            let n = (len / support).floor();
+            if n < 3.0 {
+                return Err(cx.err(
+                    "domain.max",
+                    format!("periodic axis {a} must span at least 3 kernel supports ({:.3e} m), got {len:.3e} m", 3.0 * support),
+                ));
+            }
+            let sites = len / dx;
+            if (sites - sites.round()).abs() > 1e-6 * sites.max(1.0) {
+                return Err(cx.err(
+                    "simulation.dx",
+                    format!("periodic length {len:e} m along axis {a} is not a multiple of dx"),
+                ));
+            }
+            origin[a] = lo[a];
+            grid[a] = n as u32;
+            cell[a] = len / n;
+        } else {
+            let pad = (wall_layers as f64 + 1.0) * dx;
+            origin[a] = lo[a] - pad;
+            let n = ((len + 2.0 * pad) / support).ceil().max(1.0);
+            if n > 1.0e6 {
+                return Err(cx.err(
+                    "simulation.dx",
+                    format!("cell grid too large along axis {a} ({n} cells)"),
+                ));
+            }
+            grid[a] = n as u32;
+            cell[a] = support;
+        }
+    }
+    let total: f64 = grid.iter().map(|&g| g as f64).product();
+    if total > 4.0e8 {
+        return Err(cx.err(
+            "simulation.dx",
+            format!("cell grid of {total:e} cells does not fit in memory"),
+        ));
+    }
+    Ok((origin, grid, cell))
+}
+
+pub(super) fn check_walls(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &[PhaseInfo],
+    dim: u32,
+    periodic: [bool; 3],
+) -> Result<(), InputError> {
+    let is_wall = |name: &str| {
+        phases
+            .iter()
+            .any(|p| p.name == name && p.kind == PhaseKind::Wall)
+    };
+    let needs_walls = (0..dim as usize).any(|a| !periodic[a]);
+    match &scene.domain.wall_phase {
+        Some(w) if !is_wall(w) => {
+            return Err(cx.err(
+                "domain.wall_phase",
+                format!("`{w}` is not a phase of kind \"wall\""),
+            ))
+        }
+        None if needs_walls => {
+            return Err(cx.err(
+                "domain.wall_phase",
+                "a domain with a non-periodic axis needs wall_phase",
+            ))
+        }
+        _ => {}
+    }
+    for side in &scene.domain.open_sides {
+        check_side(cx, "domain.open_sides", side, dim, periodic)?;
+    }
+    for (side, w) in &scene.domain.wall_sides {
+        let key = format!("domain.wall_sides.{side}");
+        check_side(cx, &key, side, dim, periodic)?;
+        if !is_wall(w) {
+            return Err(cx.err(&key, format!("`{w}` is not a phase of kind \"wall\"")));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn open_side_flags(scene: &SceneFile) -> [[bool; 2]; 3] {
+    let mut open = [[false; 2]; 3];
+    for (a, pair) in crate::scene::SIDE_NAMES.iter().enumerate() {
+        for (k, name) in pair.iter().enumerate() {
+            open[a][k] = scene.domain.open_sides.iter().any(|s| s == name);
+        }
+    }
+    open
+}
+
+/// A side named in the domain must exist and have walls (not absent, not periodic).
+fn check_side(
+    cx: &Ctx,
+    key: &str,
+    side: &str,
+    dim: u32,
+    periodic: [bool; 3],
+) -> Result<(), InputError> {
+    let Some(axis) = crate::scene::side_axis(side) else {
+        return Err(cx.err(
+            key,
+            format!("unknown side `{side}` (use x_min, x_max, y_min, y_max, z_min, z_max)"),
+        ));
+    };
+    if axis >= dim as usize || periodic[axis] {
+        return Err(cx.err(
+            key,
+            format!("side `{side}` has no wall (axis absent or periodic)"),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,375 @@
+//! A validated scene: every derived constant the solver needs, checked for physical
+//! sense, plus the host-side time-step limits (F22 (42)).
+
+mod domain;
+mod laser;
+mod phases;
+mod thermal;
+
+pub use laser::{Laser, MAX_LASER_POINTS};
+pub use phases::{Evaporation, PhaseInfo, Thermal};
+
+use domain::{cell_grid, check_walls, domain_box, hydrostatic_axis, open_side_flags};
+use phases::{interface_viscosity_nu, phase_table};
+use thermal::thermal_table;
+
+use crate::error::InputError;
+use crate::scene::{
+    CheckDef, Formulation, InitialPressure, KernelKind, PhaseKind, SceneFile, Slip, WatchdogDef,
+};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EndCondition {
+    Time(f64),
+    Steps(u64),
+}
+
+/// Host-side F22 (42) limits with zero velocity; the device recomputes the acoustic
+/// and force limits every step from the current maxima.
+#[derive(Debug, Clone, Copy)]
+pub struct DtLimits {
+    pub acoustic: f64,
+    pub viscous: f64,
+    pub body_force: f64,
+    /// 0.1 ρ c_p h²/k over conducting phases (issue 4); ∞ without heat.
+    pub conduction: f64,
+}
+
+impl DtLimits {
+    pub fn min(&self) -> (f64, &'static str) {
+        let mut best = (self.acoustic, "acoustic CFL 0.25 h/(c+|u|)");
+        if self.viscous < best.0 {
+            best = (self.viscous, "viscous 0.125 h^2/nu");
+        }
+        if self.body_force < best.0 {
+            best = (self.body_force, "body force 0.25 sqrt(h/|b|)");
+        }
+        if self.conduction < best.0 {
+            best = (self.conduction, "conduction 0.1 rho c_p h^2/k");
+        }
+        best
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub file: String,
+    pub resolved_toml: String,
+    pub dim: u32,
+    pub formulation: Formulation,
+    pub kernel: KernelKind,
+    pub dx: f64,
+    pub h: f64,
+    pub support: f64,
+    pub domain_lo: [f64; 3],
+    pub domain_hi: [f64; 3],
+    /// Origin of the cell grid; particle positions are stored relative to it.
+    pub origin: [f64; 3],
+    pub periodic: [bool; 3],
+    /// Sides without wall layers, by axis then (min, max).
+    pub open_sides: [[bool; 2]; 3],
+    pub grid: [u32; 3],
+    pub cell_size: [f64; 3],
+    pub wall_layers: u32,
+    pub gravity: [f64; 3],
+    pub background_pressure: f64,
+    pub pressure_floor: bool,
+    /// Gravity axis when the fluid starts hydrostatic (`simulation.initial_pressure`).
+    pub hydrostatic_axis: Option<usize>,
+    /// F22 (32) α_0^lg (0 = off).
+    pub interface_viscosity: f64,
+    pub viscous_heating: bool,
+    pub ambient_temperature: f64,
+    pub jitter: f64,
+    pub seed: u64,
+    pub phases: Vec<PhaseInfo>,
+    pub fixed_dt: Option<f64>,
+    pub end: EndCondition,
+    pub output_interval: f64,
+    pub diagnostics_interval: f64,
+    pub check: Option<CheckDef>,
+    pub watchdog: WatchdogDef,
+    pub laser: Option<Laser>,
+    pub limits: DtLimits,
+}
+
+pub const MAX_PHASES: usize = 8;
+
+impl Model {
+    pub fn max_sound_speed(&self) -> f64 {
+        self.phases
+            .iter()
+            .filter(|p| p.is_fluid())
+            .map(|p| p.sound_speed)
+            .fold(0.0, f64::max)
+    }
+    pub fn max_kinematic_viscosity(&self) -> f64 {
+        self.phases
+            .iter()
+            .filter(|p| p.is_fluid())
+            .map(|p| p.viscosity / p.rho0)
+            .fold(0.0, f64::max)
+    }
+    /// A heat scene: some phase carries a temperature.
+    /// Scenes whose physics needs interface normals and the surface delta: the
+    /// surface laser and surface losses (evaporation, radiation).
+    pub fn needs_interface(&self) -> bool {
+        let surface_laser = self
+            .laser
+            .as_ref()
+            .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface);
+        surface_laser || self.has_surface_losses() || self.interface_viscosity > 0.0
+    }
+    pub fn has_surface_losses(&self) -> bool {
+        self.phases
+            .iter()
+            .filter_map(|p| p.thermal)
+            .any(|t| t.evaporation.is_some() || t.emissivity > 0.0)
+    }
+    pub fn is_thermal(&self) -> bool {
+        self.phases.iter().any(|p| p.thermal.is_some())
+    }
+    pub fn n_cells(&self) -> u64 {
+        self.grid.iter().map(|&g| g as u64).product()
+    }
+    pub fn phase_index(&self, name: &str) -> Option<usize> {
+        self.phases.iter().position(|p| p.name == name)
+    }
+    /// Convert an absolute position to the stored (grid-relative) one.
+    pub fn to_local(&self, x: [f64; 3]) -> [f64; 3] {
+        [
+            x[0] - self.origin[0],
+            x[1] - self.origin[1],
+            x[2] - self.origin[2],
+        ]
+    }
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(&self, key: &str, msg: impl Into<String>) -> InputError {
+        InputError::new(self.file, key, msg)
+    }
+    fn positive(&self, key: &str, v: f64) -> Result<f64, InputError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("must be a positive finite number (got {v})")))
+        }
+    }
+    fn non_negative(&self, key: &str, v: f64) -> Result<f64, InputError> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("must be zero or positive (got {v})")))
+        }
+    }
+    fn vector(&self, key: &str, v: &[f64], dim: u32) -> Result<[f64; 3], InputError> {
+        if v.len() != dim as usize {
+            return Err(self.err(
+                key,
+                format!(
+                    "needs {dim} components for a {dim}D scene (got {})",
+                    v.len()
+                ),
+            ));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(self.err(key, "components must be finite numbers"));
+        }
+        let mut out = [0.0; 3];
+        out[..v.len()].copy_from_slice(v);
+        Ok(out)
+    }
+}
+
+/// Validate a parsed scene and derive all constants.
+pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model, InputError> {
+    let cx = Ctx { file };
+    let sim = &scene.simulation;
+    if sim.dimension != 2 && sim.dimension != 3 {
+        return Err(cx.err(
+            "simulation.dimension",
+            format!("must be 2 or 3 (got {})", sim.dimension),
+        ));
+    }
+    let dim = sim.dimension;
+    let dx = cx.positive("simulation.dx", sim.dx)?;
+    let h_over_dx = sim.h_over_dx.unwrap_or(sim.kernel.default_h_over_dx());
+    cx.positive("simulation.h_over_dx", h_over_dx)?;
+    if !(0.5..=3.0).contains(&h_over_dx) {
+        return Err(cx.err(
+            "simulation.h_over_dx",
+            format!("must lie in [0.5, 3] (got {h_over_dx})"),
+        ));
+    }
+    let h = h_over_dx * dx;
+    let support = sim.kernel.support_factor() * h;
+    let gravity = if sim.gravity.is_empty() {
+        [0.0; 3]
+    } else {
+        cx.vector("simulation.gravity", &sim.gravity, dim)?
+    };
+    cx.non_negative("simulation.background_pressure", sim.background_pressure)?;
+    if !(0.0..=0.5).contains(&sim.jitter) {
+        return Err(cx.err(
+            "simulation.jitter",
+            format!("must lie in [0, 0.5] (fraction of dx, got {})", sim.jitter),
+        ));
+    }
+
+    let (domain_lo, domain_hi, periodic) = domain_box(&cx, scene, dim)?;
+    let hydrostatic_axis = match sim.initial_pressure {
+        InitialPressure::Zero => None,
+        InitialPressure::Hydrostatic => Some(hydrostatic_axis(&cx, gravity, periodic)?),
+    };
+    let phases = phase_table(&cx, scene, dim, dx)?;
+    let wall_layers = (support / dx - 1e-9).ceil() as u32;
+    let (origin, grid, cell_size) = cell_grid(
+        &cx,
+        dim,
+        domain_lo,
+        domain_hi,
+        periodic,
+        support,
+        dx,
+        wall_layers,
+    )?;
+    check_walls(&cx, scene, &phases, dim, periodic)?;
+
+    let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
+    if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) {
+        return Err(cx.err("phases", "the scene has no liquid, gas or solid phase"));
+    }
+    let conduction = phases
+        .iter()
+        .filter(|p| p.conducts())
+        .map(|p| {
+            let t = p.thermal.unwrap();
+            0.1 * p.rho0 * t.heat_capacity * h * h / t.conductivity
+        })
+        .fold(f64::INFINITY, f64::min);
+    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    let nu_max = fluid
+        .iter()
+        .map(|p| p.viscosity / p.rho0)
+        .fold(interface_viscosity_nu(&cx, sim, &fluid, dim, h)?, f64::max);
+    let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
+    let limits = DtLimits {
+        acoustic: if c_max > 0.0 {
+            0.25 * h / c_max
+        } else {
+            f64::INFINITY
+        },
+        viscous: if nu_max > 0.0 {
+            0.125 * h * h / nu_max
+        } else {
+            f64::INFINITY
+        },
+        body_force: if g > 0.0 {
+            0.25 * (h / g).sqrt()
+        } else {
+            f64::INFINITY
+        },
+        conduction,
+    };
+
+    let run = &scene.run;
+    let fixed_dt = match run.dt {
+        Some(dt) => {
+            cx.positive("run.dt", dt)?;
+            let (lim, which) = limits.min();
+            if dt > lim && run.dt_check.unwrap_or(true) {
+                return Err(cx.err(
+                    "run.dt",
+                    format!(
+                        "fixed time step {dt:e} s exceeds the stability limit {lim:e} s ({which})"
+                    ),
+                ));
+            }
+            Some(dt)
+        }
+        None => None,
+    };
+    let end = match (run.end_time, run.steps) {
+        (Some(_), Some(_)) => return Err(cx.err("run", "give end_time or steps, not both")),
+        (Some(t), None) => EndCondition::Time(cx.positive("run.end_time", t)?),
+        (None, Some(n)) => EndCondition::Steps(n),
+        (None, None) => return Err(cx.err("run", "needs end_time or steps")),
+    };
+    let output_interval = match run.output_interval {
+        Some(v) => cx.positive("run.output_interval", v)?,
+        None => match end {
+            EndCondition::Time(t) => t / 20.0,
+            EndCondition::Steps(_) => f64::INFINITY,
+        },
+    };
+    let diagnostics_interval = match run.diagnostics_interval {
+        Some(v) => cx.positive("run.diagnostics_interval", v)?,
+        None => output_interval,
+    };
+    if let Some(c) = &scene.check {
+        cx.positive("check.tolerance", c.tolerance)?;
+    }
+    let laser = laser::laser_source(&cx, scene, dim, &phases)?;
+    let wd = &scene.watchdog;
+    cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
+    cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
+    cx.positive("watchdog.wall_penetration", wd.wall_penetration)?;
+    if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
+        return Err(cx.err(
+            "watchdog.max_density_ratio",
+            format!(
+                "must be a finite number above 1 (got {})",
+                wd.max_density_ratio
+            ),
+        ));
+    }
+    if wd.min_density_ratio >= 1.0 {
+        return Err(cx.err(
+            "watchdog.min_density_ratio",
+            format!("must be below 1 (got {})", wd.min_density_ratio),
+        ));
+    }
+
+    Ok(Model {
+        file: file.to_string(),
+        resolved_toml: resolved_toml.to_string(),
+        dim,
+        formulation: sim.formulation,
+        kernel: sim.kernel,
+        dx,
+        h,
+        support,
+        domain_lo,
+        domain_hi,
+        origin,
+        periodic,
+        open_sides: open_side_flags(scene),
+        grid,
+        cell_size,
+        wall_layers,
+        gravity,
+        background_pressure: sim.background_pressure,
+        viscous_heating: sim.viscous_heating,
+        ambient_temperature: cx
+            .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
+        pressure_floor: sim.pressure_floor,
+        hydrostatic_axis,
+        interface_viscosity: sim.interface_viscosity,
+        jitter: sim.jitter,
+        seed: sim.seed,
+        phases,
+        fixed_dt,
+        end,
+        output_interval,
+        diagnostics_interval,
+        check: scene.check.clone(),
+        watchdog: scene.watchdog.clone(),
+        laser,
+        limits,
+    })
+}

@@ -1,0 +1,251 @@
+//! Phases and their materials: flow properties, the phase table, interface
+//! viscosity and the phase changes melting and solidification make.
+
+use super::*;
+
+#[derive(Debug, Clone)]
+pub struct PhaseInfo {
+    pub name: String,
+    pub kind: PhaseKind,
+    pub material: String,
+    pub rho0: f64,
+    pub sound_speed: f64,
+    pub viscosity: f64,
+    pub slip: Slip,
+    pub velocity: [f64; 3],
+    /// A wall whose particles move with `velocity` (scene key `moves`).
+    pub moves: bool,
+    /// Particle mass ρ0 Δx^d (F22 Remark 2).
+    pub mass: f64,
+    pub thermal: Option<Thermal>,
+    /// Phase change: the phase a solid becomes when it melts, or a liquid when it
+    /// solidifies.
+    pub switch_to: Option<usize>,
+}
+
+/// Heat properties of a phase (heat scenes only).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Thermal {
+    /// Initial temperature, or the fixed temperature of a Dirichlet wall (K).
+    pub temperature: f64,
+    pub conductivity: f64,
+    pub heat_capacity: f64,
+    /// (solidus, liquidus, latent heat) when the material melts.
+    pub melting: Option<(f64, f64, f64)>,
+    /// Liquid-state (conductivity, heat capacity); equal to the solid's unless given.
+    pub liquid: (f64, f64),
+    /// Surface losses (liquid and solid free surfaces).
+    pub evaporation: Option<Evaporation>,
+    pub emissivity: f64,
+    /// Mushy-zone sink C (1/s), 0 for none.
+    pub mushy_damping: f64,
+}
+
+/// F22 (10), (18) constants: the scenario's table, once validated.
+pub use crate::scene::EvaporationDef as Evaporation;
+
+impl Evaporation {
+    /// Recoil pressure p_v(T) F22 (10).
+    pub fn pressure(&self, t: f64) -> f64 {
+        self.pressure_constant
+            * (-self.temperature_constant * (1.0 / t - 1.0 / self.boiling_temperature)).exp()
+    }
+    /// Heat lost per unit area, ṁ (h_v + c_p (T − T_h0)) F22 (18).
+    pub fn flux(&self, t: f64, cp: f64) -> f64 {
+        let mdot = 0.82 * self.sticking * self.pressure(t) * (self.vapor_constant / t).sqrt();
+        mdot * (self.latent_heat + cp * (t - self.enthalpy_reference))
+    }
+}
+
+impl Thermal {
+    /// The temperature whose enthalpy is stored as zero: the solidus for a melting
+    /// material (so phases that switch into each other share it), else the phase's
+    /// initial temperature. Particles store h − h(T_ref): f32 then resolves the
+    /// enthalpy changes a run makes far more finely than absolute enthalpies near
+    /// c_p T (adiabatic_box with temperature-dependent properties drifted 2.8e-6
+    /// over 10^4 steps with absolute enthalpies).
+    pub fn reference_temperature(&self) -> f64 {
+        self.melting.map_or(self.temperature, |m| m.0)
+    }
+    /// h(T_ref), added back to the stored enthalpy for totals and output.
+    pub fn reference_enthalpy(&self) -> f64 {
+        self.enthalpy(self.reference_temperature())
+    }
+    /// Specific enthalpy h(T) = ∫_0^T c_p dT + L f_l(T) (J22 (19)): c_p is the
+    /// solid's below the solidus, the liquid's above the liquidus and linear in
+    /// between, where the latent heat is spread linearly too.
+    pub fn enthalpy(&self, t: f64) -> f64 {
+        let cs = self.heat_capacity;
+        let Some((ts, tl, l)) = self.melting else {
+            return cs * t;
+        };
+        let cl = self.liquid.1;
+        let dt = tl - ts;
+        if t <= ts {
+            cs * t
+        } else if t < tl {
+            let x = t - ts;
+            cs * t + (cl - cs) * x * x / (2.0 * dt) + l * x / dt
+        } else {
+            cs * tl + (cl - cs) * dt / 2.0 + l + cl * (t - tl)
+        }
+    }
+}
+
+impl PhaseInfo {
+    /// Liquid or gas: moves with the flow.
+    pub fn is_fluid(&self) -> bool {
+        matches!(self.kind, PhaseKind::Liquid | PhaseKind::Gas)
+    }
+    /// Carries a temperature that evolves (fluids and solids in heat scenes).
+    pub fn conducts(&self) -> bool {
+        self.kind != PhaseKind::Wall && self.thermal.is_some()
+    }
+}
+
+pub(super) fn phase_table(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+    dx: f64,
+) -> Result<Vec<PhaseInfo>, InputError> {
+    if scene.phases.len() > MAX_PHASES {
+        return Err(cx.err(
+            "phases",
+            format!("at most {MAX_PHASES} phases are supported"),
+        ));
+    }
+    let mut out = Vec::new();
+    for (name, p) in &scene.phases {
+        let key = |k: &str| format!("phases.{name}.{k}");
+        let Some(mat) = scene.materials.get(&p.material) else {
+            return Err(cx.err(
+                &key("material"),
+                format!("no material named `{}`", p.material),
+            ));
+        };
+        let mkey = |k: &str| format!("materials.{}.{k}", p.material);
+        let rho0 = cx.positive(&mkey("density"), mat.density)?;
+        let viscosity = cx.non_negative(&mkey("viscosity"), mat.viscosity)?;
+        let sound_speed = match (mat.sound_speed, mat.reference_pressure) {
+            (Some(c), None) => cx.positive(&mkey("sound_speed"), c)?,
+            (None, Some(p0)) => (cx.positive(&mkey("reference_pressure"), p0)? / rho0).sqrt(),
+            (Some(_), Some(_)) => {
+                return Err(cx.err(
+                    &mkey("sound_speed"),
+                    "give sound_speed or reference_pressure, not both",
+                ))
+            }
+            (None, None) => {
+                return Err(cx.err(
+                    &mkey("sound_speed"),
+                    "missing: give sound_speed or reference_pressure",
+                ))
+            }
+        };
+        let velocity = match &p.velocity {
+            Some(v) if p.kind == PhaseKind::Wall => cx.vector(&key("velocity"), v, dim)?,
+            Some(_) => {
+                return Err(cx.err(
+                    &key("velocity"),
+                    "only wall phases take a prescribed velocity",
+                ))
+            }
+            None => [0.0; 3],
+        };
+        if p.moves && (p.kind != PhaseKind::Wall || p.velocity.is_none()) {
+            return Err(cx.err(&key("moves"), "only a wall phase with a velocity can move"));
+        }
+        out.push(PhaseInfo {
+            name: name.clone(),
+            kind: p.kind,
+            material: p.material.clone(),
+            rho0,
+            sound_speed,
+            viscosity,
+            slip: p.slip,
+            velocity,
+            moves: p.moves,
+            mass: rho0 * dx.powi(dim as i32),
+            thermal: None,
+            switch_to: None,
+        });
+    }
+    thermal_table(cx, scene, &mut out)?;
+    phase_changes(cx, scene, &mut out)?;
+    Ok(out)
+}
+
+/// Solid ↔ liquid pairs from `melts_into`: same material, one that melts.
+fn phase_changes(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Result<(), InputError> {
+    for s in 0..phases.len() {
+        let def = &scene.phases[&phases[s].name];
+        let Some(target) = &def.melts_into else {
+            continue;
+        };
+        let key = format!("phases.{}.melts_into", phases[s].name);
+        if phases[s].kind != PhaseKind::Solid {
+            return Err(cx.err(&key, "only solid phases melt"));
+        }
+        let Some(l) = phases.iter().position(|p| &p.name == target) else {
+            return Err(cx.err(&key, format!("no phase named `{target}`")));
+        };
+        if phases[l].kind != PhaseKind::Liquid {
+            return Err(cx.err(&key, format!("`{target}` is not a liquid phase")));
+        }
+        if phases[l].material != phases[s].material {
+            return Err(cx.err(
+                &key,
+                "the solid and the liquid must share a material (one melting band)",
+            ));
+        }
+        if phases[s].thermal.and_then(|t| t.melting).is_none() {
+            return Err(cx.err(
+                &key,
+                format!(
+                    "material `{}` has no solidus/liquidus/latent_heat",
+                    phases[s].material
+                ),
+            ));
+        }
+        if phases[l].switch_to.is_some_and(|o| o != s) {
+            return Err(cx.err(
+                &key,
+                format!("`{target}` already solidifies into another phase"),
+            ));
+        }
+        phases[s].switch_to = Some(l);
+        phases[l].switch_to = Some(s);
+    }
+    Ok(())
+}
+
+/// Heat properties: a scene is a heat scene when any phase has a temperature.
+/// Then every non-wall phase needs a temperature, conductivity and heat capacity.
+
+/// The kinematic viscosity F22 (31) acts with at most: the artificial-viscosity
+/// term equals a shear viscosity ν = α h c/(2(d + 2)) (Monaghan 2005), and
+/// α = α_0^lg min(h δ, 1) ≤ α_0^lg (backend/cpu/forces.rs), so the viscous limit
+/// 0.125 h²/ν covers it.
+pub(super) fn interface_viscosity_nu(
+    cx: &Ctx,
+    sim: &crate::scene::Simulation,
+    fluid: &[&PhaseInfo],
+    dim: u32,
+    h: f64,
+) -> Result<f64, InputError> {
+    let key = "simulation.interface_viscosity";
+    let alpha = cx.non_negative(key, sim.interface_viscosity)?;
+    if alpha == 0.0 {
+        return Ok(0.0);
+    }
+    let has = |k: PhaseKind| fluid.iter().any(|p| p.kind == k);
+    if !has(PhaseKind::Liquid) || !has(PhaseKind::Gas) {
+        return Err(cx.err(
+            key,
+            "acts at a liquid–gas interface: the scene needs a liquid and a gas phase",
+        ));
+    }
+    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    Ok(alpha * h * c_max / (2.0 * (dim as f64 + 2.0)))
+}

@@ -1,0 +1,134 @@
+//! Heat: each phase's thermal material (conduction, melting band, evaporation,
+//! radiation) from the scene's heat keys.
+
+use super::*;
+
+pub(super) fn thermal_table(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &mut [PhaseInfo],
+) -> Result<(), InputError> {
+    let heat_scene = scene.phases.values().any(|p| p.temperature.is_some());
+    for ph in phases.iter_mut() {
+        let def = &scene.phases[&ph.name];
+        let mat = &scene.materials[&def.material];
+        let mkey = |k: &str| format!("materials.{}.{k}", def.material);
+        let tkey = format!("phases.{}.temperature", ph.name);
+        let Some(t) = def.temperature else {
+            if heat_scene && ph.kind != PhaseKind::Wall {
+                return Err(cx.err(&tkey, "missing: a heat scene needs the initial temperature of every liquid, gas and solid phase"));
+            }
+            if ph.kind == PhaseKind::Solid {
+                return Err(cx.err(
+                    &tkey,
+                    "missing: solid phases conduct heat and need a temperature",
+                ));
+            }
+            continue;
+        };
+        cx.positive(&tkey, t)?;
+        if ph.kind == PhaseKind::Wall {
+            // A Dirichlet wall takes the conducting particle's own k (J22 (25)).
+            ph.thermal = Some(Thermal {
+                temperature: t,
+                conductivity: 0.0,
+                heat_capacity: 0.0,
+                melting: None,
+                liquid: (0.0, 0.0),
+                evaporation: None,
+                emissivity: 0.0,
+                mushy_damping: 0.0,
+            });
+            continue;
+        }
+        let need = |k: &str, v: Option<f64>| -> Result<f64, InputError> {
+            match v {
+                Some(v) => cx.positive(&mkey(k), v),
+                None => Err(cx.err(&mkey(k), "missing: needed by a phase with a temperature")),
+            }
+        };
+        let conductivity = need("conductivity", mat.conductivity)?;
+        let heat_capacity = need("heat_capacity", mat.heat_capacity)?;
+        let melting = match (mat.solidus, mat.liquidus, mat.latent_heat) {
+            (None, None, None) => None,
+            (Some(ts), Some(tl), Some(l)) => {
+                cx.positive(&mkey("solidus"), ts)?;
+                if !(tl > ts && tl.is_finite()) {
+                    return Err(cx.err(
+                        &mkey("liquidus"),
+                        format!("must exceed the solidus {ts} K (got {tl})"),
+                    ));
+                }
+                Some((ts, tl, cx.non_negative(&mkey("latent_heat"), l)?))
+            }
+            _ => {
+                return Err(cx.err(
+                    &mkey("solidus"),
+                    "give solidus, liquidus and latent_heat together",
+                ))
+            }
+        };
+        let evaporation = match &mat.evaporation {
+            None => None,
+            Some(_) if ph.kind != PhaseKind::Liquid => None,
+            Some(e) => {
+                let k = |n: &str| mkey(&format!("evaporation.{n}"));
+                cx.positive(&k("pressure_constant"), e.pressure_constant)?;
+                cx.positive(&k("temperature_constant"), e.temperature_constant)?;
+                cx.positive(&k("boiling_temperature"), e.boiling_temperature)?;
+                cx.positive(&k("latent_heat"), e.latent_heat)?;
+                cx.non_negative(&k("enthalpy_reference"), e.enthalpy_reference)?;
+                cx.positive(&k("vapor_constant"), e.vapor_constant)?;
+                cx.positive(&k("sticking"), e.sticking)?;
+                Some(*e)
+            }
+        };
+        let emissivity = match mat.emissivity {
+            Some(e) if !(0.0..=1.0).contains(&e) => {
+                return Err(cx.err(&mkey("emissivity"), format!("must lie in [0, 1] (got {e})")))
+            }
+            Some(e) => e,
+            None => 0.0,
+        };
+        let mushy_damping = match mat.mushy_damping {
+            Some(_) if melting.is_none() => {
+                return Err(cx.err(
+                    &mkey("mushy_damping"),
+                    "needs a melting band (solidus, liquidus, latent_heat)",
+                ));
+            }
+            Some(c) => cx.non_negative(&mkey("mushy_damping"), c)?,
+            None => 0.0,
+        };
+        let liquid = match (mat.liquid_conductivity, mat.liquid_heat_capacity) {
+            (None, None) => (conductivity, heat_capacity),
+            _ if melting.is_none() => {
+                return Err(cx.err(
+                    &mkey("liquid_conductivity"),
+                    "liquid properties need a melting band (solidus, liquidus, latent_heat)",
+                ))
+            }
+            (k, c) => (
+                match k {
+                    Some(k) => cx.positive(&mkey("liquid_conductivity"), k)?,
+                    None => conductivity,
+                },
+                match c {
+                    Some(c) => cx.positive(&mkey("liquid_heat_capacity"), c)?,
+                    None => heat_capacity,
+                },
+            ),
+        };
+        ph.thermal = Some(Thermal {
+            temperature: t,
+            conductivity,
+            heat_capacity,
+            melting,
+            liquid,
+            evaporation,
+            emissivity,
+            mushy_damping,
+        });
+    }
+    Ok(())
+}

@@ -99,16 +99,8 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let k = thread_index(gid, nwg);
     if (k >= P.sizes.n_particles) { return; }
     let s = keys[k].y;
-    s_pos[k] = pos[s];
-    s_vel[k] = vel[s];
-    s_acc[k] = acc[s];
-    s_acc_b[k] = acc_b[s];
-    s_mass[k] = mass[s];
-    s_phase[k] = phase[s];
-    s_pid[k] = pid[s];
-    if ((P.sizes.flags & FLAG_HEAT) != 0u) {
-        s_heat[k] = heat[s];
-    }
+    // Every sorted field of crate::fields::FIELDS: s_<field>[k] = <field>[s].
+    #reorder_sorted_fields(k, s)
 }
 
 @compute @workgroup_size(64)

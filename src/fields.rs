@@ -1,7 +1,9 @@
 //! The per-particle field registry: one row per array of `State`, and everything
 //! that handles fields generically reads it: GPU allocation, upload, readback and
-//! the reorder copies (backend::gpu), checkpoints (checkpoint.rs), `compare`
-//! (State::fields) and the memory estimate. The CPU passes use the arrays by name.
+//! the copies after the sort (backend::gpu), the sort itself (the CPU permutation in
+//! backend::cpu::neighbors, the WGSL reorder body from `wgsl_reorder`), checkpoints
+//! (checkpoint.rs), `compare` (State::fields) and the memory estimate. The passes
+//! use the arrays by name.
 //!
 //! Adding a field: its array in `State`, one row here, its WGSL binding in
 //! shaders/lib/bindings.wgsl (and its scratch's when it is reordered) and in
@@ -67,6 +69,8 @@ pub struct FieldDef {
     pub words: fn(&State) -> &[u32],
     /// Replace the array from little-endian bytes (length checked by the caller).
     pub set: fn(&mut State, &[u8]),
+    /// Reorder the array: entry k becomes old entry perm[k] (sorted fields).
+    pub permute: fn(&mut State, &[usize]),
 }
 
 impl FieldDef {
@@ -91,6 +95,7 @@ macro_rules! field {
             compared: true,
             words: |s| bytemuck::cast_slice(&s.$array),
             set: |s, b| s.$array = bytemuck::pod_collect_to_vec(b),
+            permute: |s, perm| permute(&mut s.$array, perm),
         }
     };
 }
@@ -181,6 +186,38 @@ pub const FIELDS: [FieldDef; 11] = [
         Holder::Interface
     ),
 ];
+
+/// out[k] = v[perm[k]], in parallel.
+fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[usize]) {
+    use rayon::prelude::*;
+    let src = &*v;
+    let out: Vec<T> = perm.par_iter().map(|&s| src[s]).collect();
+    *v = out;
+}
+
+/// The WGSL reorder body (neighbors.wgsl `#reorder_sorted_fields(k, s)`): every
+/// sorted field's scratch at k takes the field at s; a field only some scenes hold
+/// is guarded by that scene flag.
+pub fn wgsl_reorder(k: &str, s: &str, indent: &str) -> String {
+    let mut out = String::new();
+    for f in FIELDS.iter() {
+        let Some(scratch) = f.scratch else { continue };
+        let copy = format!("{scratch}[{k}] = {}[{s}];", f.binding);
+        match f.holder {
+            Holder::Every => out.push_str(&format!("{indent}{copy}\n")),
+            h => {
+                let flag = match h {
+                    Holder::Heat => "FLAG_HEAT",
+                    _ => "FLAG_INTERFACE",
+                };
+                out.push_str(&format!(
+                    "{indent}if ((P.sizes.flags & {flag}) != 0u) {{\n{indent}    {copy}\n{indent}}}\n"
+                ));
+            }
+        }
+    }
+    out
+}
 
 /// Bytes per particle the fields of a scene take on the device, scratch included.
 pub fn bytes_per_particle(held: Held) -> usize {

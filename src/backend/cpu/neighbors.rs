@@ -2,6 +2,7 @@
 //! every particle array by cell, and the cell start/end table.
 //! Keys are unique, so any correct sort gives the one order the GPU's bitonic sort gives.
 
+use crate::fields::{Held, FIELDS};
 use crate::params::Params;
 use crate::state::State;
 use rayon::prelude::*;
@@ -428,15 +429,14 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
         .collect();
     keys.par_sort_unstable();
     let perm: Vec<usize> = keys.iter().map(|k| k.1 as usize).collect();
-    permute(&mut st.pos, &perm);
-    permute(&mut st.vel, &perm);
-    permute(&mut st.acc, &perm);
-    permute(&mut st.acc_b, &perm);
-    permute(&mut st.mass, &perm);
-    permute(&mut st.phase, &perm);
-    permute(&mut st.id, &perm);
-    if !st.heat.is_empty() {
-        permute(&mut st.heat, &perm);
+    // Every sorted field the scene holds (crate::fields); the others are
+    // recomputed after the sort.
+    let held = Held::of_state(st);
+    for f in FIELDS
+        .iter()
+        .filter(|f| f.scratch.is_some() && held.holds(f.holder))
+    {
+        (f.permute)(st, &perm);
     }
     let n_cells = pr.sizes.n_cells as usize;
     grid.invalidate();
@@ -458,12 +458,6 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
             grid.fluid[c as usize] = true;
         }
     }
-}
-
-fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[usize]) {
-    let src = &*v;
-    let out: Vec<T> = perm.par_iter().map(|&s| src[s]).collect();
-    *v = out;
 }
 
 #[cfg(test)]

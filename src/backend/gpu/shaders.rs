@@ -143,7 +143,40 @@ pub fn compose(name: &str, pass: &str) -> Result<String, String> {
         out.push_str(term);
         out.push('\n');
     }
-    out.push_str(&expand_walks(pass)?);
+    out.push_str(&expand_walks(&expand_reorder(pass)?)?);
+    Ok(out)
+}
+
+const REORDER_DIRECTIVE: &str = "#reorder_sorted_fields(";
+
+/// Replace a `#reorder_sorted_fields(k, s)` line with the copies of every sorted
+/// field (crate::fields::wgsl_reorder), so the reorder pass follows the registry.
+pub fn expand_reorder(src: &str) -> Result<String, String> {
+    let mut out = String::with_capacity(src.len());
+    for (n, line) in src.lines().enumerate() {
+        let indent = &line[..line.len() - line.trim_start().len()];
+        match line.trim_start().strip_prefix(REORDER_DIRECTIVE) {
+            Some(args) => {
+                let a: Vec<&str> = args
+                    .strip_suffix(')')
+                    .ok_or_else(|| format!("line {}: '{REORDER_DIRECTIVE}k, s)' expected", n + 1))?
+                    .split(',')
+                    .map(str::trim)
+                    .collect();
+                let [k, s] = a[..] else {
+                    return Err(format!("line {}: the reorder takes (k, s)", n + 1));
+                };
+                out.push_str(&crate::fields::wgsl_reorder(k, s, indent));
+            }
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    if !src.ends_with('\n') {
+        out.pop();
+    }
     Ok(out)
 }
 
@@ -317,6 +350,25 @@ mod tests {
         assert!(expand_walks("    #for_each_neighbor(ci, zr, j) {\n        x;\n").is_err());
         assert!(expand_walks("    #for_each_neighbor(ci, j) {\n    }\n").is_err());
         assert!(compose("x", "// uses: params nonsense\n").is_err());
+    }
+
+    /// The reorder expands to the copies the pass had written out before the
+    /// field registry drove it: the same text, so the same compiled pass.
+    #[test]
+    fn reorder_expands_to_every_sorted_field() {
+        let got = expand_reorder("    #reorder_sorted_fields(k, s)\n").unwrap();
+        let want = "    s_pos[k] = pos[s];
+    s_vel[k] = vel[s];
+    s_acc[k] = acc[s];
+    s_acc_b[k] = acc_b[s];
+    s_mass[k] = mass[s];
+    s_phase[k] = phase[s];
+    s_pid[k] = pid[s];
+    if ((P.sizes.flags & FLAG_HEAT) != 0u) {
+        s_heat[k] = heat[s];
+    }
+";
+        assert_eq!(got, want);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 // uses: params bindings grid phase
-// writes: keys cell_start cell_end s_pos s_vel s_acc s_acc_b s_mass s_phase s_pid s_heat
+// writes: keys cell_start cell_end s_pos s_vel s_acc s_acc_b s_mass s_phase s_id s_heat
 // Neighbour search. Twin of src/backend/cpu/neighbors.rs.
 // 1. cell_keys: key (cell, index) per particle; padding keys sort last.
 // 2. bitonic sort over the padded keys. Keys are unique, so the result is the single

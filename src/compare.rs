@@ -330,7 +330,7 @@ mod tests {
             acc: vec![[0.0; 4]],
             acc_b: vec![[0.0; 4]],
             rho: vec![rho],
-            p: vec![0.0],
+            press: vec![0.0],
             mass: vec![1.0],
             phase: vec![0],
             id: vec![0],

@@ -143,7 +143,7 @@ pub const FIELDS: [FieldDef; 11] = [
         Holder::Every
     ),
     field!("density", rho, "rho", None, 1, 1, true, Holder::Every),
-    field!("pressure", p, "press", None, 1, 1, true, Holder::Every),
+    field!("pressure", press, "press", None, 1, 1, true, Holder::Every),
     field!(
         "mass",
         mass,
@@ -164,7 +164,7 @@ pub const FIELDS: [FieldDef; 11] = [
         false,
         Holder::Every
     ),
-    field!("id", id, "pid", Some("s_pid"), 1, 1, false, Holder::Every),
+    field!("id", id, "id", Some("s_id"), 1, 1, false, Holder::Every),
     field!(
         "heat",
         heat,

@@ -331,7 +331,7 @@ fn hydrostatic_start(m: &Model, st: &mut State, sites: &[[u32; 3]], axis: usize)
         let compression = p / (ph.rho0 * ph.sound_speed * ph.sound_speed);
         st.mass[i] = (ph.mass * (1.0 + compression)) as f32;
         st.rho[i] = (ph.rho0 * (1.0 + compression)) as f32;
-        st.p[i] = p as f32;
+        st.press[i] = p as f32;
     }
 }
 
@@ -354,7 +354,7 @@ fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
     st.acc.push([0.0; 4]);
     st.acc_b.push([0.0; 4]);
     st.rho.push(ph.rho0 as f32);
-    st.p.push(0.0);
+    st.press.push(0.0);
     st.mass.push(ph.mass as f32);
     st.phase.push(pi as u32);
     st.id.push(id);

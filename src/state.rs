@@ -38,7 +38,7 @@ pub struct State {
     /// Transport-velocity (background pressure) acceleration.
     pub acc_b: Vec<[f32; 4]>,
     pub rho: Vec<f32>,
-    pub p: Vec<f32>,
+    pub press: Vec<f32>,
     pub mass: Vec<f32>,
     pub phase: Vec<u32>,
     pub id: Vec<u32>,

@@ -100,7 +100,7 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
             return Some((name, x as f64, "not finite".into()));
         }
     }
-    for (name, x) in [("density", st.rho[i]), ("pressure", st.p[i])] {
+    for (name, x) in [("density", st.rho[i]), ("pressure", st.press[i])] {
         if !x.is_finite() {
             return Some((name, x as f64, "not finite".into()));
         }
@@ -193,7 +193,7 @@ mod tests {
         st.rho.iter_mut().for_each(|r| *r = 1000.0);
         let f = fluid(&m, &st);
         st.vel[f[7]][1] = f32::NAN;
-        st.p[f[3]] = f32::INFINITY;
+        st.press[f[3]] = f32::INFINITY;
         let t = scan(&m, &st).expect("trip");
         assert_eq!(t.particle, Some(st.id[f[3]].min(st.id[f[7]])));
         assert!(t.reason.contains("not finite"));

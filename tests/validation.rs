@@ -88,7 +88,7 @@ fn hydrostatic_start_stacks_the_layers() {
         } else {
             rho_g * g * 0.1 + rho_l * g * (0.1 - y)
         };
-        let p = st.p[i] as f64;
+        let p = st.press[i] as f64;
         assert!(
             (p - expected).abs() <= 1e-4 * expected,
             "particle at y = {y}: p = {p}, expected {expected}"

@@ -10,7 +10,7 @@
 @group(0) @binding(6) var<storage, read_write> press: array<f32>;
 @group(0) @binding(7) var<storage, read_write> mass: array<f32>;
 @group(0) @binding(8) var<storage, read_write> phase: array<u32>;
-@group(0) @binding(9) var<storage, read_write> pid: array<u32>;
+@group(0) @binding(9) var<storage, read_write> id: array<u32>;
 @group(0) @binding(10) var<storage, read_write> keys: array<vec2<u32>>;
 @group(0) @binding(11) var<storage, read_write> cell_start: array<u32>;
 @group(0) @binding(12) var<storage, read_write> cell_end: array<u32>;
@@ -20,7 +20,7 @@
 @group(0) @binding(16) var<storage, read_write> s_acc_b: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> s_mass: array<f32>;
 @group(0) @binding(18) var<storage, read_write> s_phase: array<u32>;
-@group(0) @binding(19) var<storage, read_write> s_pid: array<u32>;
+@group(0) @binding(19) var<storage, read_write> s_id: array<u32>;
 @group(0) @binding(20) var<storage, read_write> sim: Sim;
 @group(0) @binding(21) var<storage, read_write> partials: array<vec2<f32>>;
 // Heat scenes: (h, T, f_l, dh/dt) and its reorder scratch; a 16-byte placeholder

@@ -152,7 +152,7 @@ pub(super) fn particles<'a>(m: &'a Model, st: &'a State) -> impl Iterator<Item =
                 x[2] as f64 + m.origin[2],
             ],
             v: [v[0] as f64, v[1] as f64, v[2] as f64],
-            p: st.p[i] as f64,
+            p: st.press[i] as f64,
             kind: m.phases[st.phase[i] as usize].kind,
         }
     })

@@ -71,7 +71,7 @@ pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
         f("vy", vel(1)),
         f("vz", vel(2)),
         f("density", Values::F32(st.rho.clone())),
-        f("pressure", Values::F32(st.p.clone())),
+        f("pressure", Values::F32(st.press.clone())),
         f("mass", Values::F32(st.mass.clone())),
         f("phase", Values::U32(st.phase.clone())),
         f("id", Values::U32(st.id.clone())),

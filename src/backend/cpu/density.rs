@@ -15,7 +15,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborLis
     let chunks: Vec<ListChunk> = st
         .rho
         .par_chunks_mut(LIST_CHUNK)
-        .zip(st.p.par_chunks_mut(LIST_CHUNK))
+        .zip(st.press.par_chunks_mut(LIST_CHUNK))
         .zip(chunks)
         .enumerate()
         .map(|(c, ((rho, p), mut chunk))| {

@@ -48,7 +48,8 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool>(
     grid: &CellTable,
     list: &NeighborList,
 ) {
-    let (pos, vel, rho, p, mass, phase) = (&st.pos, &st.vel, &st.rho, &st.p, &st.mass, &st.phase);
+    let (pos, vel, rho, p, mass, phase) =
+        (&st.pos, &st.vel, &st.rho, &st.press, &st.mass, &st.phase);
     let surface = &st.surface;
     // Per particle and per phase pair once, what the pair loop would otherwise
     // compute per pair from the same operands: the same bits, fewer divisions.

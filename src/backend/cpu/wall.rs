@@ -28,7 +28,7 @@ use rayon::prelude::*;
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     let n = st.len();
     let (pos, phase) = (&st.pos, &st.phase);
-    let (rho_in, p_in, vel_in) = (&st.rho, &st.p, &st.vel);
+    let (rho_in, p_in, vel_in) = (&st.rho, &st.press, &st.vel);
     let out: Vec<Option<(f32, f32, [f32; 4])>> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -85,7 +85,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     for (i, o) in out.into_iter().enumerate() {
         if let Some((rho, p, v)) = o {
             st.rho[i] = rho;
-            st.p[i] = p;
+            st.press[i] = p;
             st.vel[i] = v;
         }
     }
@@ -117,7 +117,7 @@ mod tests {
             st.acc.push([0.0; 4]);
             st.acc_b.push([0.0; 4]);
             st.rho.push(1000.0);
-            st.p.push(1000.0);
+            st.press.push(1000.0);
             st.mass.push(st0.mass[i]);
             st.phase.push(st0.phase[i]);
             st.id.push(i as u32);
@@ -129,7 +129,7 @@ mod tests {
         neighbors::run(&pr, &mut st, &mut grid);
         super::run(&pr, &mut st, &grid);
         let k = st.id.iter().position(|&id| id == w as u32).unwrap();
-        (st.p[k], st.vel[k], pr.kernel.support2.sqrt())
+        (st.press[k], st.vel[k], pr.kernel.support2.sqrt())
     }
 
     /// Adami's extrapolation p_w = p_f + ρ_f g·(r_w − r_f) with one neighbour well

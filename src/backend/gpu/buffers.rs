@@ -28,7 +28,7 @@ pub const BINDINGS: [&str; 27] = [
     "press",
     "mass",
     "phase",
-    "pid",
+    "id",
     // Neighbour search: sort keys and the cell table.
     "keys",
     "cell_start",
@@ -40,7 +40,7 @@ pub const BINDINGS: [&str; 27] = [
     "s_acc_b",
     "s_mass",
     "s_phase",
-    "s_pid",
+    "s_id",
     // Per-step scalars and the reduction's partial maxima.
     "sim",
     "partials",

@@ -363,7 +363,7 @@ mod tests {
     s_acc_b[k] = acc_b[s];
     s_mass[k] = mass[s];
     s_phase[k] = phase[s];
-    s_pid[k] = pid[s];
+    s_id[k] = id[s];
     if ((P.sizes.flags & FLAG_HEAT) != 0u) {
         s_heat[k] = heat[s];
     }

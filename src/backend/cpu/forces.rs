@@ -20,24 +20,29 @@ use crate::params::{Params, KIND_WALL, PHASE_FREE_SLIP};
 use crate::state::State;
 use rayon::prelude::*;
 
+/// Calls `f::<…>(args)` with one const bool per runtime switch, in order: one
+/// monomorphised function per combination, chosen once per call.
+macro_rules! monomorphise {
+    ($f:ident::<$($done:literal),*>($($arg:expr),*); []) => {
+        $f::<$($done),*>($($arg),*)
+    };
+    ($f:ident::<$($done:literal),*>($($arg:expr),*); [$head:expr $(, $rest:expr)*]) => {
+        if $head {
+            monomorphise!($f::<$($done,)* true>($($arg),*); [$($rest),*])
+        } else {
+            monomorphise!($f::<$($done,)* false>($($arg),*); [$($rest),*])
+        }
+    };
+}
+
 /// The sweep with the scene's switchable pair terms compiled in and the others
-/// compiled out (backend::terms).
+/// compiled out (backend::terms), one const parameter of `sweep` per switch.
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
-    let on = [
+    monomorphise!(sweep::<>(pr, st, grid, list); [
         active(pr, "background_pressure"),
         active(pr, "interface_viscosity"),
-        active(pr, "viscous_heating"),
-    ];
-    match on {
-        [false, false, false] => sweep::<false, false, false>(pr, st, grid, list),
-        [false, false, true] => sweep::<false, false, true>(pr, st, grid, list),
-        [false, true, false] => sweep::<false, true, false>(pr, st, grid, list),
-        [false, true, true] => sweep::<false, true, true>(pr, st, grid, list),
-        [true, false, false] => sweep::<true, false, false>(pr, st, grid, list),
-        [true, false, true] => sweep::<true, false, true>(pr, st, grid, list),
-        [true, true, false] => sweep::<true, true, false>(pr, st, grid, list),
-        [true, true, true] => sweep::<true, true, true>(pr, st, grid, list),
-    }
+        active(pr, "viscous_heating")
+    ])
 }
 
 /// One fused neighbour sweep: BG, IV, VH switch the background pressure, the

@@ -220,9 +220,6 @@ fn phase_changes(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
     Ok(())
 }
 
-/// Heat properties: a scene is a heat scene when any phase has a temperature.
-/// Then every non-wall phase needs a temperature, conductivity and heat capacity.
-
 /// The kinematic viscosity F22 (31) acts with at most: the artificial-viscosity
 /// term equals a shear viscosity ν = α h c/(2(d + 2)) (Monaghan 2005), and
 /// α = α_0^lg min(h δ, 1) ≤ α_0^lg (backend/cpu/forces.rs), so the viscous limit

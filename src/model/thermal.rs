@@ -3,6 +3,8 @@
 
 use super::*;
 
+/// Heat properties: a scene is a heat scene when any phase has a temperature.
+/// Then every non-wall phase needs a temperature, conductivity and heat capacity.
 pub(super) fn thermal_table(
     cx: &Ctx,
     scene: &SceneFile,

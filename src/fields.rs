@@ -2,14 +2,16 @@
 //! that handles fields generically reads it: GPU allocation, upload, readback and
 //! the copies after the sort (backend::gpu), the sort itself (the CPU permutation in
 //! backend::cpu::neighbors, the WGSL reorder body from `wgsl_reorder`), checkpoints
-//! (checkpoint.rs), `compare` (State::fields) and the memory estimate. The passes
-//! use the arrays by name.
+//! (checkpoint.rs), `compare` (State::fields), the MCAP/VTK frame channels
+//! (output::particle_fields) and the memory estimate. The passes use the arrays by
+//! name.
 //!
 //! Adding a field: its array in `State`, one row here, its WGSL binding in
 //! shaders/lib/bindings.wgsl (and its scratch's when it is reordered) and in
 //! `backend::gpu::BINDINGS`; tests/fields.rs checks that the rows, the bindings and
 //! the WGSL agree.
 
+use crate::output::{self, Values};
 use crate::state::State;
 
 /// Which scenes hold a field (elsewhere its array is empty and its GPU buffer a
@@ -71,7 +73,12 @@ pub struct FieldDef {
     pub set: fn(&mut State, &[u8]),
     /// Reorder the array: entry k becomes old entry perm[k] (sorted fields).
     pub permute: fn(&mut State, &[usize]),
+    /// The channels it writes to MCAP and VTK frames (None: not written).
+    pub frames: Option<Channels>,
 }
+
+/// A field's output channels (crate::output).
+pub type Channels = fn(&crate::model::Model, &State) -> Vec<crate::output::Field>;
 
 impl FieldDef {
     pub fn bytes_per_particle(&self) -> usize {
@@ -82,7 +89,7 @@ impl FieldDef {
 /// Declares one field row from its `State` array.
 macro_rules! field {
     ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
-     $per:literal, $float:literal, $holder:expr) => {
+     $per:literal, $float:literal, $holder:expr, $frames:expr) => {
         FieldDef {
             name: $name,
             binding: $binding,
@@ -96,95 +103,36 @@ macro_rules! field {
             words: |s| bytemuck::cast_slice(&s.$array),
             set: |s, b| s.$array = bytemuck::pod_collect_to_vec(b),
             permute: |s, perm| permute(&mut s.$array, perm),
+            frames: $frames,
         }
     };
 }
 
-/// Every per-particle field, in checkpoint and `compare` order.
+/// Every per-particle field, in checkpoint, `compare` and frame order. Columns:
+/// name, State array, binding, scratch, words per entry, entries per particle,
+/// float, holder, frame channels.
+#[rustfmt::skip]
 pub const FIELDS: [FieldDef; 11] = [
-    field!(
-        "position",
-        pos,
-        "pos",
-        Some("s_pos"),
-        4,
-        1,
-        true,
-        Holder::Every
-    ),
-    field!(
-        "velocity",
-        vel,
-        "vel",
-        Some("s_vel"),
-        4,
-        1,
-        true,
-        Holder::Every
-    ),
-    field!(
-        "acceleration",
-        acc,
-        "acc",
-        Some("s_acc"),
-        4,
-        1,
-        true,
-        Holder::Every
-    ),
-    field!(
-        "transport_acceleration",
-        acc_b,
-        "acc_b",
-        Some("s_acc_b"),
-        4,
-        1,
-        true,
-        Holder::Every
-    ),
-    field!("density", rho, "rho", None, 1, 1, true, Holder::Every),
-    field!("pressure", press, "press", None, 1, 1, true, Holder::Every),
-    field!(
-        "mass",
-        mass,
-        "mass",
-        Some("s_mass"),
-        1,
-        1,
-        true,
-        Holder::Every
-    ),
-    field!(
-        "phase",
-        phase,
-        "phase",
-        Some("s_phase"),
-        1,
-        1,
-        false,
-        Holder::Every
-    ),
-    field!("id", id, "id", Some("s_id"), 1, 1, false, Holder::Every),
-    field!(
-        "heat",
-        heat,
-        "heat",
-        Some("s_heat"),
-        4,
-        1,
-        true,
-        Holder::Heat
-    ),
-    field!(
-        "surface",
-        surface,
-        "surface",
-        None,
-        4,
-        2,
-        true,
-        Holder::Interface
-    ),
+    field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
+        Some(output::position_channels)),
+    field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
+        Some(output::velocity_channels)),
+    field!("acceleration", acc, "acc", Some("s_acc"), 4, 1, true, Holder::Every, None),
+    field!("transport_acceleration", acc_b, "acc_b", Some("s_acc_b"), 4, 1, true,
+        Holder::Every, None),
+    field!("density", rho, "rho", None, 1, 1, true, Holder::Every,
+        Some(|_, s| output::channel("density", Values::F32(s.rho.clone())))),
+    field!("pressure", press, "press", None, 1, 1, true, Holder::Every,
+        Some(|_, s| output::channel("pressure", Values::F32(s.press.clone())))),
+    field!("mass", mass, "mass", Some("s_mass"), 1, 1, true, Holder::Every,
+        Some(|_, s| output::channel("mass", Values::F32(s.mass.clone())))),
+    field!("phase", phase, "phase", Some("s_phase"), 1, 1, false, Holder::Every,
+        Some(|_, s| output::channel("phase", Values::U32(s.phase.clone())))),
+    field!("id", id, "id", Some("s_id"), 1, 1, false, Holder::Every,
+        Some(|_, s| output::channel("id", Values::U32(s.id.clone())))),
+    field!("heat", heat, "heat", Some("s_heat"), 4, 1, true, Holder::Heat,
+        Some(output::heat_channels)),
+    field!("surface", surface, "surface", None, 4, 2, true, Holder::Interface, None),
 ];
 
 /// out[k] = v[perm[k]], in parallel.

@@ -2,7 +2,8 @@
 //! diagnostics record, and the sinks (MCAP stream, VTK series, checkpoints).
 //!
 //! One list of fields (`particle_fields`) feeds both MCAP and VTK, so a field added
-//! to the state appears in every format at once.
+//! to the state appears in every format at once: each row of the field registry
+//! (crate::fields) names the channels it writes to frames.
 
 pub mod mcap_out;
 pub mod pointcloud;
@@ -55,30 +56,50 @@ pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
     (st.pos[i][a] as f64 + m.origin[a]) as f32
 }
 
-/// Every per-particle field a frame carries: x, y, z (m), vx, vy, vz (m/s), density
-/// (kg/m³), pressure (Pa), mass (kg), phase (index into the scene's phases) and id
-/// (the particle's index at setup, stable across reordering).
+/// Every per-particle field a frame carries, from the field registry's `frames`
+/// channels in registry order: x, y, z (m), vx, vy, vz (m/s), density (kg/m³),
+/// pressure (Pa), mass (kg), phase (index into the scene's phases), id (the
+/// particle's index at setup, stable across reordering), and in heat scenes
+/// temperature (K), liquid fraction and specific enthalpy (J/kg).
 pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
-    let n = st.len();
-    let coord = |a: usize| Values::F32((0..n).map(|i| world_coord(m, st, i, a)).collect());
+    let held = crate::fields::Held::of_state(st);
+    crate::fields::FIELDS
+        .iter()
+        .filter(|f| held.holds(f.holder))
+        .filter_map(|f| f.frames)
+        .flat_map(|channels| channels(m, st))
+        .collect()
+}
+
+/// One channel.
+pub fn channel(name: &'static str, values: Values) -> Vec<Field> {
+    vec![Field { name, values }]
+}
+
+/// Position channels: world coordinates x, y, z (m).
+pub fn position_channels(m: &Model, st: &State) -> Vec<Field> {
+    let coord = |a: usize| Values::F32((0..st.len()).map(|i| world_coord(m, st, i, a)).collect());
+    ["x", "y", "z"]
+        .into_iter()
+        .enumerate()
+        .map(|(a, name)| Field {
+            name,
+            values: coord(a),
+        })
+        .collect()
+}
+
+/// Velocity channels vx, vy, vz (m/s).
+pub fn velocity_channels(_m: &Model, st: &State) -> Vec<Field> {
     let vel = |a: usize| Values::F32(st.vel.iter().map(|v| v[a]).collect());
-    let f = |name, values| Field { name, values };
-    vec![
-        f("x", coord(0)),
-        f("y", coord(1)),
-        f("z", coord(2)),
-        f("vx", vel(0)),
-        f("vy", vel(1)),
-        f("vz", vel(2)),
-        f("density", Values::F32(st.rho.clone())),
-        f("pressure", Values::F32(st.press.clone())),
-        f("mass", Values::F32(st.mass.clone())),
-        f("phase", Values::U32(st.phase.clone())),
-        f("id", Values::U32(st.id.clone())),
-    ]
-    .into_iter()
-    .chain(heat_fields(m, st))
-    .collect()
+    ["vx", "vy", "vz"]
+        .into_iter()
+        .enumerate()
+        .map(|(a, name)| Field {
+            name,
+            values: vel(a),
+        })
+        .collect()
 }
 
 /// Specific enthalpy h(T) of particle i (J/kg): the stored value plus its phase's
@@ -92,7 +113,7 @@ pub fn absolute_enthalpy(m: &Model, st: &State, i: usize) -> f64 {
 }
 
 /// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).
-fn heat_fields(m: &Model, st: &State) -> Vec<Field> {
+pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     if st.heat.is_empty() {
         return Vec::new();
     }

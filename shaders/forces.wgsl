@@ -29,9 +29,9 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     var fb = vec3<f32>(0.0);
     var heating = 0.0;
     var alpha_i = 0.0;
-    // The runtime test is not needed for the result: it keeps lavapipe's NIR from
-    // factoring α_0 out of α_i + α_j (the CPU twin multiplies each), which made
-    // two_layer_ratio1000_2d differ by 2 ULP at step 48 without it.
+    // The runtime test is not needed for the result, but without it lavapipe's
+    // two_layer_ratio1000_2d differed from the CPU twin by 2 ULP at step 48, as if
+    // α_0 had been factored out of α_i + α_j (the CPU multiplies each).
     if (TERM_INTERFACE_VISCOSITY && P.flow.interface_viscosity > 0.0) {
         alpha_i = interface_viscosity_alpha(surface[i].w);
     }

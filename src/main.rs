@@ -183,6 +183,7 @@ fn cmd_run(
         (None, Some(p)) => (run::load(p, sets)?, None),
         (None, None) => unreachable!("clap requires a scenario or --resume"),
     };
+    print_warnings(&loaded.model);
     let label = path.or(resumed_from).unwrap_or_default();
     let end = match (until, steps) {
         (Some(t), _) if t > 0.0 => EndCondition::Time(t),
@@ -372,8 +373,16 @@ fn cmd_inspect(path: &str) -> Result<ExitCode, SpatterError> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Input that is valid but probably not meant (model::Model::warnings), on stderr.
+fn print_warnings(m: &spatter::model::Model) {
+    for w in &m.warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
 fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     let loaded = run::load(path, sets)?;
+    print_warnings(&loaded.model);
     let m = &loaded.model;
     let st = &loaded.state;
     println!("scenario: {path}");

@@ -15,7 +15,7 @@ fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
         return vec![(0.0, false)];
     }
     let (lo, hi, dx) = (m.domain_lo[a], m.domain_hi[a], m.dx);
-    let n = ((hi - lo) / dx + 1e-9).floor() as i64;
+    let n = m.sites[a] as i64;
     let mut out: Vec<(f64, bool)> = Vec::with_capacity(n as usize + 2 * m.wall_layers as usize);
     let walls = if m.periodic[a] {
         0
@@ -44,7 +44,7 @@ fn axis_sites_len(m: &Model, a: usize) -> f64 {
     if a >= m.dim as usize {
         return 1.0;
     }
-    let n = ((m.domain_hi[a] - m.domain_lo[a]) / m.dx + 1e-9).floor();
+    let n = m.sites[a] as f64;
     let walls = if m.periodic[a] {
         0.0
     } else {

@@ -28,6 +28,87 @@ pub(super) fn domain_box(
     Ok((lo, hi, periodic))
 }
 
+/// How close (in particle spacings) a length must come to a whole number of
+/// spacings to count as one: far above the rounding of a spacing written to eight
+/// digits (L/30 as 6.6666667e-5 leaves 1.5e-7), far below any gap a user means.
+pub const LATTICE_TOLERANCE: f64 = 1e-6;
+
+/// Lattice sites along an extent: the nearest whole number of spacings when the
+/// extent is within `LATTICE_TOLERANCE` of one, else Err(the fractional gap the
+/// last site would leave, in spacings).
+pub fn lattice_sites(extent: f64, dx: f64) -> Result<u64, f64> {
+    let r = extent / dx;
+    let n = r.round();
+    if (r - n).abs() <= LATTICE_TOLERANCE * r.max(1.0) && n >= 1.0 {
+        Ok(n as u64)
+    } else {
+        Err(r - r.floor())
+    }
+}
+
+/// Sites per axis inside the domain. An extent within `LATTICE_TOLERANCE` of a
+/// whole number of spacings gets that number; any other leaves a gap of less than
+/// one spacing empty before the far wall (or inside the period), which a warning
+/// names (the peer-comparison scene keeps its peer's box on purpose).
+pub(super) fn domain_sites(
+    cx: &Ctx,
+    dim: u32,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    dx: f64,
+    warnings: &mut Vec<String>,
+) -> [u64; 3] {
+    let mut sites = [1u64; 3];
+    for a in 0..dim as usize {
+        let extent = hi[a] - lo[a];
+        sites[a] = lattice_sites(extent, dx).unwrap_or_else(|gap| {
+            warnings.push(format!(
+                "{}: key `domain.max`: the extent along {} is {:.6} particle spacings \
+                 (dx = {dx} m), not a whole number: a {gap:.3} dx gap stays empty before \
+                 the far side; make the extent a multiple of dx",
+                cx.file,
+                AXES[a],
+                extent / dx
+            ));
+            (extent / dx).floor().max(1.0) as u64
+        });
+    }
+    sites
+}
+
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// A box face on a lattice site (within `LATTICE_TOLERANCE` of lo + (k + ½) dx)
+/// fills or skips that whole row depending on rounding: warn, naming the shape,
+/// the axis and where the face sits.
+pub(super) fn box_face_warnings(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+    lo: [f64; 3],
+    dx: f64,
+    warnings: &mut Vec<String>,
+) {
+    for (i, s) in scene.shapes.iter().enumerate() {
+        let Some(b) = &s.box_ else { continue };
+        for (face, values) in [("min", &b.min), ("max", &b.max)] {
+            for (a, &x) in values.iter().enumerate().take(dim as usize) {
+                let u = (x - lo[a]) / dx - 0.5;
+                if (u - u.round()).abs() <= LATTICE_TOLERANCE * u.abs().max(1.0) {
+                    warnings.push(format!(
+                        "{}: key `shapes[{i}].box.{face}`: along {} the face sits on a row of \
+                         lattice sites ({:.6} dx from domain.min), so whether that row is \
+                         filled depends on rounding; move the face by half a spacing",
+                        cx.file,
+                        AXES[a],
+                        u + 0.5
+                    ));
+                }
+            }
+        }
+    }
+}
+
 /// The axis a hydrostatic start stacks the fluid along: gravity must point along
 /// exactly one axis, and that axis must not be periodic (no top to hang from).
 pub(super) fn hydrostatic_axis(

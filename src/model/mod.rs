@@ -9,7 +9,11 @@ mod thermal;
 pub use laser::{Laser, MAX_LASER_POINTS};
 pub use phases::{Evaporation, PhaseInfo, Thermal};
 
-use domain::{cell_grid, check_walls, domain_box, hydrostatic_axis, open_side_flags};
+use domain::{
+    box_face_warnings, cell_grid, check_walls, domain_box, domain_sites, hydrostatic_axis,
+    open_side_flags,
+};
+pub use domain::{lattice_sites, LATTICE_TOLERANCE};
 use phases::{interface_viscosity_nu, phase_table};
 use thermal::thermal_table;
 
@@ -59,6 +63,11 @@ pub struct Model {
     pub formulation: Formulation,
     pub kernel: KernelKind,
     pub dx: f64,
+    /// Lattice sites per axis inside the domain (1 beyond the dimension).
+    pub sites: [u64; 3],
+    /// Input that is valid but probably not what was meant, each naming file, key
+    /// and what to change; `run` and `validate` print them.
+    pub warnings: Vec<String>,
     pub h: f64,
     pub support: f64,
     pub domain_lo: [f64; 3],
@@ -226,6 +235,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         InitialPressure::Zero => None,
         InitialPressure::Hydrostatic => Some(hydrostatic_axis(&cx, gravity, periodic)?),
     };
+    let mut warnings = Vec::new();
+    let sites = domain_sites(&cx, dim, domain_lo, domain_hi, dx, &mut warnings);
+    box_face_warnings(&cx, scene, dim, domain_lo, dx, &mut warnings);
     let phases = phase_table(&cx, scene, dim, dx)?;
     let wall_layers = (support / dx - 1e-9).ceil() as u32;
     let (origin, grid, cell_size) = cell_grid(
@@ -342,6 +354,8 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         formulation: sim.formulation,
         kernel: sim.kernel,
         dx,
+        sites,
+        warnings,
         h,
         support,
         domain_lo,

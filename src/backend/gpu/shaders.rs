@@ -68,18 +68,26 @@ fn writes(src: &str) -> Option<Vec<&str>> {
         .map(|l| l.split_whitespace().collect())
 }
 
-/// The bindings library with every storage buffer the pass does not write declared
-/// `read` (atomics stay read_write, as WGSL requires). naga rejects a store to a
-/// `read` buffer, so a `// writes:` line that misses one fails tests/shaders.rs.
-fn restrict_access(bindings: &str, written: &[&str]) -> String {
+/// The name of a storage binding a pass may declare `read`: read_write in the
+/// library and not atomic (WGSL keeps atomics read_write).
+fn restrictable(line: &str) -> Option<&str> {
+    if line.contains("atomic<") {
+        return None;
+    }
+    line.split("var<storage, read_write> ")
+        .nth(1)?
+        .split(':')
+        .next()
+}
+
+/// The bindings library with the `read_only` buffers declared `read`. naga rejects
+/// a store to a `read` buffer, so a `// writes:` line that misses one fails
+/// tests/shaders.rs.
+fn restrict_access(bindings: &str, read_only: &[&str]) -> String {
     let mut out = String::with_capacity(bindings.len());
     for line in bindings.lines() {
-        let name = line
-            .split("var<storage, read_write> ")
-            .nth(1)
-            .and_then(|rest| rest.split(':').next());
-        match name {
-            Some(n) if !written.contains(&n) && !line.contains("atomic<") => {
+        match restrictable(line) {
+            Some(n) if read_only.contains(&n) => {
                 out.push_str(&line.replacen("read_write", "read", 1))
             }
             _ => out.push_str(line),
@@ -89,22 +97,21 @@ fn restrict_access(bindings: &str, written: &[&str]) -> String {
     out
 }
 
-/// The bindings a pass reads only (declared `read` in its composed source): its
-/// bind group layout must say so too.
+/// The bindings a pass reads only: every restrictable one its `// writes:` line
+/// does not name (none without such a line). Its composed WGSL declares them
+/// `read` and its bind group layout read-only.
 pub fn read_only_bindings(pass: &str) -> Vec<&'static str> {
+    let Some(w) = writes(pass) else {
+        return Vec::new();
+    };
     let bindings = LIBS
         .iter()
         .find(|(n, _)| *n == "bindings")
         .expect("bindings")
         .1;
-    let Some(w) = writes(pass) else {
-        return Vec::new();
-    };
     bindings
         .lines()
-        .filter(|l| !l.contains("atomic<"))
-        .filter_map(|l| l.split("var<storage, read_write> ").nth(1))
-        .filter_map(|rest| rest.split(':').next())
+        .filter_map(restrictable)
         .filter(|n| !w.contains(n))
         .collect()
 }
@@ -131,10 +138,10 @@ fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
 /// neighbour walk expanded.
 pub fn compose(name: &str, pass: &str) -> Result<String, String> {
     let mut out = String::new();
-    let written = writes(pass);
+    let read_only = read_only_bindings(pass);
     for k in resolve(&uses(pass))? {
-        match (LIBS[k].0, &written) {
-            ("bindings", Some(w)) => out.push_str(&restrict_access(LIBS[k].1, w)),
+        match LIBS[k].0 {
+            "bindings" => out.push_str(&restrict_access(LIBS[k].1, &read_only)),
             _ => out.push_str(LIBS[k].1),
         }
         out.push('\n');

@@ -95,3 +95,20 @@ fn a_box_face_on_a_row_of_sites_is_reported() {
     let own = load(&common::scene("poiseuille_2d"), &[]).unwrap();
     assert!(own.model.warnings.is_empty(), "{:?}", own.model.warnings);
 }
+
+/// A periodic axis of exactly three kernel supports is accepted whatever the
+/// rounding of Δx = L/n: poiseuille_2d's 0.6 mm period at Δx = 1 mm/15 is 3 × 3Δx
+/// (quintic), but 6e-4 / (3 · 6.666…e-5) evaluates to 2.9999999999999996. Before,
+/// that floor gave 2 cells and the scene was refused; poiseuille_2d at its own Δx
+/// (3.999… supports) had 3 cells of 1.33 supports instead of 4.
+#[test]
+fn periodic_cells_do_not_depend_on_rounding() {
+    let l = load(
+        &common::scene("poiseuille_2d"),
+        &["dx=6.666666666666667e-5".into()],
+    )
+    .unwrap();
+    assert_eq!(l.model.grid[0], 3);
+    let l = load(&common::scene("poiseuille_2d"), &[]).unwrap();
+    assert_eq!(l.model.grid[0], 4);
+}

@@ -153,7 +153,11 @@ pub(super) fn cell_grid(
         let len = hi[a] - lo[a];
         if periodic[a] {
             // Cells tile the period exactly so wrapped neighbours land in whole cells.
-            let n = (len / support).floor();
+            // A period within LATTICE_TOLERANCE of a whole number of supports (Δx =
+            // L/n written in decimal) gets that many cells: they are then shorter
+            // than the support by at most that fraction, where the kernel is 0 to
+            // far below f32 resolution (quintic: (3 − q)^5 < 1e-27).
+            let n = (len / support * (1.0 + LATTICE_TOLERANCE)).floor();
             if n < 3.0 {
                 return Err(cx.err(
                     "domain.max",

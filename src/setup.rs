@@ -155,11 +155,14 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
                     format!("needs {dim}-component base and non-zero axis, positive radius"),
                 ));
             }
+            // The end discs reach r √(1 − u_a²) beyond the axis along axis a (u the
+            // unit axis): nothing along the axis itself, r across it.
+            let reach = |a: usize| c.radius * (1.0 - c.axis[a] * c.axis[a] / len2).max(0.0).sqrt();
             let lo = (0..dim)
-                .map(|a| c.base[a].min(c.base[a] + c.axis[a]) - c.radius)
+                .map(|a| c.base[a].min(c.base[a] + c.axis[a]) - reach(a))
                 .collect();
             let hi = (0..dim)
-                .map(|a| c.base[a].max(c.base[a] + c.axis[a]) + c.radius)
+                .map(|a| c.base[a].max(c.base[a] + c.axis[a]) + reach(a))
                 .collect();
             (lo, hi, "cylinder")
         };
@@ -183,9 +186,9 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
 
 /// A small deterministic generator (SplitMix64) for the optional jitter; its output
 /// is fixed by the seed on every platform.
-struct SplitMix(u64);
+pub(crate) struct SplitMix(pub(crate) u64);
 impl SplitMix {
-    fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_f64(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

@@ -111,6 +111,39 @@ enum BenchKind {
         #[arg(long, value_enum)]
         backend: Vec<BackendChoice>,
     },
+    /// Work-precision: each validation scene at 3-5 resolutions and each kernel;
+    /// error, cost, memory and the observed convergence order.
+    Accuracy {
+        /// Scenes to sweep (default: all; with --quick the quick set).
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<String>,
+        #[arg(long, value_enum, default_value = "auto")]
+        backend: BackendChoice,
+        /// The two coarsest resolutions of a few scenes, quintic kernel only (CI).
+        #[arg(long)]
+        quick: bool,
+        /// Write every figure as JSON.
+        #[arg(long)]
+        json: Option<String>,
+        /// Write a work-precision PNG per scene and a convergence summary here.
+        #[arg(long, value_name = "DIR")]
+        plots: Option<String>,
+    },
+    /// Stress suite: long runs, parameter extremes, seeded random scenes; each case
+    /// survived, stopped by the watchdog, or crashed (exit 1: a crash is a bug).
+    Stability {
+        #[arg(long, value_enum, default_value = "auto")]
+        backend: BackendChoice,
+        /// A few cases of each group, a few hundred to 1,500 steps each (CI).
+        #[arg(long)]
+        quick: bool,
+        /// Write every case as JSON.
+        #[arg(long)]
+        json: Option<String>,
+        /// First seed of the random scenes (scene k uses seed + k).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 fn main() -> ExitCode {
@@ -141,15 +174,7 @@ fn main() -> ExitCode {
             sets,
             by_tolerance,
         } => cmd_compare(&scenario, steps, &sets, by_tolerance),
-        Command::Bench {
-            which:
-                BenchKind::Throughput {
-                    json,
-                    sizes,
-                    steps,
-                    backend,
-                },
-        } => bench::throughput(&sizes, steps, &backend, json.as_deref()).map(|_| ExitCode::SUCCESS),
+        Command::Bench { which } => cmd_bench(which),
     };
     match result {
         Ok(code) => code,
@@ -161,6 +186,49 @@ fn main() -> ExitCode {
             eprintln!("error: {m}");
             ExitCode::from(1)
         }
+    }
+}
+
+fn cmd_bench(which: BenchKind) -> Result<ExitCode, SpatterError> {
+    match which {
+        BenchKind::Throughput {
+            json,
+            sizes,
+            steps,
+            backend,
+        } => bench::throughput(&sizes, steps, &backend, json.as_deref()).map(|_| ExitCode::SUCCESS),
+        BenchKind::Accuracy {
+            scenes,
+            backend,
+            quick,
+            json,
+            plots,
+        } => bench::accuracy::accuracy(&bench::accuracy::Options {
+            scenes: &scenes,
+            backend,
+            quick,
+            json: json.as_deref(),
+            plots: plots.as_deref(),
+        })
+        .map(|_| ExitCode::SUCCESS),
+        BenchKind::Stability {
+            backend,
+            quick,
+            json,
+            seed,
+        } => bench::stability::stability(&bench::stability::Options {
+            backend,
+            quick,
+            json: json.as_deref(),
+            seed,
+        })
+        .map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }),
     }
 }
 

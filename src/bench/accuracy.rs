@@ -1,0 +1,502 @@
+//! `spatter bench accuracy`: work–precision of the validation scenes. Each scene
+//! with a reference solution runs at several resolutions (Δx = L/n over a table of
+//! cell counts n that fill its boxes exactly) and with each kernel; every run gives
+//! its check's error, wall time, steps, particle-steps/s and memory. Per scene and
+//! kernel the observed convergence order (least-squares slope of log error against
+//! log Δx) is printed beside the order the method should reach.
+
+use super::plot::{self, Figure, Guide, Series};
+use crate::backend::gpu::{AdapterChoice, GpuContext};
+use crate::error::{InputError, SpatterError};
+use crate::model;
+use crate::run::{self, BackendChoice, Loaded, Outputs, RunEnd, RunOptions};
+use crate::scene::{self, KernelKind};
+use crate::setup;
+use std::path::Path;
+
+/// One scene's resolution sweep.
+pub struct Sweep {
+    pub name: &'static str,
+    text: &'static str,
+    /// Reference length L (m): the runs use Δx = L/n.
+    length: f64,
+    /// Cell counts n across L, coarse to fine; each fills the scene's boxes with
+    /// whole rows (a fill that does not is reported as a warning on the run).
+    cells: &'static [u32],
+    /// The order the error should fall with Δx; None where the metric is a
+    /// conservation error that sits at round-off at every resolution.
+    pub expected_order: Option<f64>,
+    /// Why that order (printed beside the fit).
+    why: &'static str,
+    /// Part of `--quick` (its two coarsest resolutions, quintic kernel only).
+    quick: bool,
+}
+
+macro_rules! scene_text {
+    ($name:literal) => {
+        include_str!(concat!("../../scenarios/validation/", $name, ".toml"))
+    };
+}
+
+/// With h/Δx fixed, SPH sums are 2nd order in h only until the kernel's own
+/// discretisation error takes over (Quinlan, Basa & Lastiwka 2006): a floor that
+/// depends on the kernel and h/Δx, not on Δx.
+const SECOND_ORDER: &str =
+    "2nd order in h at fixed h/dx, down to the kernel's discretisation floor";
+
+/// The scenes with a reference solution and their sweeps.
+pub const SWEEPS: &[Sweep] = &[
+    Sweep {
+        name: "poiseuille_2d",
+        text: scene_text!("poiseuille_2d"),
+        length: 1.0e-3,
+        cells: &[15, 20, 25, 30, 40],
+        expected_order: Some(2.0),
+        why: SECOND_ORDER,
+        quick: true,
+    },
+    Sweep {
+        name: "couette_2d",
+        text: scene_text!("couette_2d"),
+        length: 1.0e-3,
+        cells: &[15, 20, 25, 30, 40],
+        expected_order: Some(2.0),
+        why: SECOND_ORDER,
+        quick: true,
+    },
+    Sweep {
+        name: "hydrostatic_2d",
+        text: scene_text!("hydrostatic_2d"),
+        length: 0.1,
+        cells: &[4, 5, 8, 10],
+        expected_order: Some(1.0),
+        why: "the wall layer and the free surface truncate the kernel: 1st order there",
+        quick: false,
+    },
+    Sweep {
+        name: "hydrostatic_3d",
+        text: scene_text!("hydrostatic_3d"),
+        length: 0.1,
+        cells: &[4, 5, 8],
+        expected_order: Some(1.0),
+        why: "the wall layer and the free surface truncate the kernel: 1st order there",
+        quick: false,
+    },
+    Sweep {
+        name: "two_layer_2d",
+        text: scene_text!("two_layer_2d"),
+        length: 0.1,
+        cells: &[10, 16, 20, 25],
+        expected_order: Some(1.0),
+        why: "the density jump is smeared over one kernel support: 1st order at the interface",
+        quick: false,
+    },
+    Sweep {
+        name: "conduction_1d",
+        text: scene_text!("conduction_1d"),
+        length: 0.01,
+        // Periodic in x: at least three quintic supports (9 Δx) across.
+        cells: &[10, 12, 14, 16],
+        expected_order: Some(2.0),
+        why: SECOND_ORDER,
+        quick: true,
+    },
+    Sweep {
+        name: "conduction_two_materials",
+        text: scene_text!("conduction_two_materials"),
+        length: 0.02,
+        // Periodic in x (at least 9 Δx across); n even puts the material jump on a row gap.
+        cells: &[10, 12, 14, 16],
+        expected_order: Some(2.0),
+        why: "harmonic-mean conductivity keeps the flux across the material jump 2nd order",
+        quick: false,
+    },
+    Sweep {
+        name: "stefan_1d",
+        text: scene_text!("stefan_1d"),
+        length: 0.04,
+        cells: &[20, 25, 32, 40, 50],
+        expected_order: Some(1.0),
+        why: "the front crosses one particle at a time: 1st order in its position",
+        quick: true,
+    },
+    Sweep {
+        name: "rosenthal_2d",
+        text: scene_text!("rosenthal_2d"),
+        length: 2.0e-4,
+        cells: &[4, 5, 8, 10],
+        expected_order: Some(2.0),
+        why: SECOND_ORDER,
+        quick: false,
+    },
+    Sweep {
+        name: "laser_flat_plate",
+        text: scene_text!("laser_flat_plate"),
+        length: 2.0e-4,
+        cells: &[10, 16, 20, 25],
+        expected_order: None,
+        why: "energy balance: conserved to f32 round-off at every resolution",
+        quick: true,
+    },
+];
+
+const KERNELS: [KernelKind; 3] = [
+    KernelKind::Quintic,
+    KernelKind::WendlandC2,
+    KernelKind::Cubic,
+];
+
+fn kernel_key(k: KernelKind) -> &'static str {
+    match k {
+        KernelKind::Quintic => "quintic",
+        KernelKind::WendlandC2 => "wendland_c2",
+        KernelKind::Cubic => "cubic",
+    }
+}
+
+#[derive(serde::Serialize, Clone)]
+pub struct AccuracyRun {
+    pub scene: String,
+    pub kernel: String,
+    pub cells: u32,
+    pub dx: f64,
+    pub particles: usize,
+    pub steps: u64,
+    pub wall_s: f64,
+    pub particle_steps_per_s: f64,
+    /// Memory the scene's particle state takes (setup::memory_estimate).
+    pub state_bytes: f64,
+    /// Peak resident memory of the process during this run (Linux VmHWM after a reset).
+    pub peak_rss_bytes: Option<u64>,
+    pub metric: String,
+    pub error: f64,
+    pub tolerance: f64,
+    pub pass: bool,
+    /// "completed", or the watchdog's diagnosis.
+    pub end: String,
+    /// Scene warnings at this resolution (e.g. a box that does not fill whole rows).
+    pub warnings: Vec<String>,
+}
+
+#[derive(serde::Serialize, Clone)]
+pub struct OrderFit {
+    pub scene: String,
+    pub kernel: String,
+    /// Least-squares slope of ln(error) against ln(Δx); None with fewer than two
+    /// runs with a positive finite error.
+    pub observed_order: Option<f64>,
+    pub expected_order: Option<f64>,
+    pub why: String,
+    /// The error falls from each resolution to the next finer one.
+    pub monotone: bool,
+}
+
+#[derive(serde::Serialize)]
+pub struct AccuracyReport {
+    pub backend: String,
+    pub quick: bool,
+    pub runs: Vec<AccuracyRun>,
+    pub orders: Vec<OrderFit>,
+}
+
+pub struct Options<'a> {
+    pub scenes: &'a [String],
+    pub backend: BackendChoice,
+    pub quick: bool,
+    pub json: Option<&'a str>,
+    pub plots: Option<&'a str>,
+}
+
+/// The sweeps `--scenes` names (all, or the quick ones with `--quick`).
+fn chosen(opts: &Options) -> Result<Vec<&'static Sweep>, SpatterError> {
+    if opts.scenes.is_empty() {
+        return Ok(SWEEPS.iter().filter(|s| s.quick || !opts.quick).collect());
+    }
+    opts.scenes
+        .iter()
+        .map(|n| {
+            SWEEPS.iter().find(|s| s.name == n).ok_or_else(|| {
+                let known: Vec<&str> = SWEEPS.iter().map(|s| s.name).collect();
+                InputError::new(
+                    "bench accuracy",
+                    "--scenes",
+                    format!("unknown scene `{n}` (known: {})", known.join(", ")),
+                )
+                .into()
+            })
+        })
+        .collect()
+}
+
+fn load(sw: &Sweep, kernel: KernelKind, cells: u32) -> Result<Loaded, SpatterError> {
+    let dx = sw.length / cells as f64;
+    let sets = [
+        format!("dx={dx:e}"),
+        format!("kernel={}", kernel_key(kernel)),
+    ];
+    let label = format!("scenarios/validation/{}.toml", sw.name);
+    let (sc, resolved) = scene::parse_str(&label, sw.text, &sets)?;
+    let model = model::build(&label, &sc, &resolved)?;
+    let state = setup::generate(&model, &sc)?;
+    Ok(Loaded { model, state })
+}
+
+fn run_one(
+    sw: &Sweep,
+    kernel: KernelKind,
+    cells: u32,
+    choice: BackendChoice,
+) -> Result<(AccuracyRun, String), SpatterError> {
+    let l = load(sw, kernel, cells)?;
+    super::reset_peak_rss();
+    let mut backend = run::make_backend(choice, &l, false)?;
+    let opts = RunOptions {
+        end: l.model.end,
+        quiet: true,
+        resumed: false,
+    };
+    let report = run::run(&l, backend.as_mut(), &opts, &mut Outputs::default())?;
+    let (metric, error, tolerance, pass) = match &report.check {
+        Some(c) => (c.metric.clone(), c.value, c.tolerance, c.pass),
+        None => (String::new(), f64::NAN, f64::NAN, false),
+    };
+    let end = match &report.end {
+        RunEnd::Completed => "completed".to_string(),
+        RunEnd::Interrupted => "interrupted".to_string(),
+        RunEnd::Unstable(t) => format!("stopped: {}", t.message()),
+    };
+    let n = l.state.len();
+    let row = AccuracyRun {
+        scene: sw.name.into(),
+        kernel: kernel_key(kernel).into(),
+        cells,
+        dx: l.model.dx,
+        particles: n,
+        steps: report.steps,
+        wall_s: report.wall_s,
+        particle_steps_per_s: report.particle_steps_per_s(),
+        state_bytes: setup::memory_estimate(&l.model, n as f64),
+        peak_rss_bytes: super::peak_rss(),
+        metric,
+        error,
+        tolerance,
+        pass,
+        end,
+        warnings: l.model.warnings.clone(),
+    };
+    Ok((row, backend.describe()))
+}
+
+/// Least-squares slope of ln(error) against ln(Δx) over the runs with a positive
+/// finite error.
+pub fn fit_order(runs: &[&AccuracyRun]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = runs
+        .iter()
+        .filter(|r| r.error.is_finite() && r.error > 0.0)
+        .map(|r| (r.dx.ln(), r.error.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxx: f64 = pts.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+fn print_run(r: &AccuracyRun) {
+    println!(
+        "  {:<24} {:<11} n {:>3}  dx {:.3e}  {:>6} particles  {:>7} steps  {:>8.2} s  {:.2e} p-steps/s  {:>7.2} MiB state  error {:.3e} {}{}",
+        r.scene,
+        r.kernel,
+        r.cells,
+        r.dx,
+        r.particles,
+        r.steps,
+        r.wall_s,
+        r.particle_steps_per_s,
+        r.state_bytes / (1024.0 * 1024.0),
+        r.error,
+        if r.pass { "PASS" } else { "FAIL" },
+        if r.end == "completed" { String::new() } else { format!(" ({})", r.end) }
+    );
+    for w in &r.warnings {
+        println!("    warning: {w}");
+    }
+}
+
+fn print_fit(f: &OrderFit) {
+    let observed = f.observed_order.map_or("n/a".into(), |o| format!("{o:.2}"));
+    let expected = f
+        .expected_order
+        .map_or("none, a conservation error".into(), |o| format!("{o:.0}"));
+    println!(
+        "  {:<24} {:<11} observed order {:>5}, expected {} ({}){}",
+        f.scene,
+        f.kernel,
+        observed,
+        expected,
+        f.why,
+        if f.monotone {
+            ""
+        } else {
+            "; error not monotone in dx"
+        }
+    );
+}
+
+/// `auto` decided once for the whole sweep: a hardware GPU if there is one, else
+/// the CPU (the software adapter is for bit-match tests, not for benchmarks).
+fn resolve(choice: BackendChoice) -> BackendChoice {
+    match choice {
+        BackendChoice::Auto => match GpuContext::open(AdapterChoice::HardwareOnly, false) {
+            Ok(_) => BackendChoice::Gpu,
+            Err(_) => BackendChoice::Cpu,
+        },
+        c => c,
+    }
+}
+
+pub fn accuracy(opts: &Options) -> Result<(), SpatterError> {
+    let sweeps = chosen(opts)?;
+    let choice = resolve(opts.backend);
+    let kernels: &[KernelKind] = if opts.quick { &KERNELS[..1] } else { &KERNELS };
+    let mut runs = Vec::new();
+    let mut orders = Vec::new();
+    let mut backend = String::new();
+    println!(
+        "bench accuracy: {} scene(s) x {} kernel(s){}",
+        sweeps.len(),
+        kernels.len(),
+        if opts.quick {
+            ", quick (two coarsest resolutions)"
+        } else {
+            ""
+        }
+    );
+    for sw in &sweeps {
+        let cells = if opts.quick { &sw.cells[..2] } else { sw.cells };
+        for &k in kernels {
+            let first = runs.len();
+            for &n in cells {
+                let (row, described) = run_one(sw, k, n, choice)?;
+                backend = described;
+                print_run(&row);
+                runs.push(row);
+            }
+            let mine: Vec<&AccuracyRun> = runs[first..].iter().collect();
+            let fit = OrderFit {
+                scene: sw.name.into(),
+                kernel: kernel_key(k).into(),
+                observed_order: fit_order(&mine),
+                expected_order: sw.expected_order,
+                why: sw.why.into(),
+                monotone: mine.windows(2).all(|w| w[1].error < w[0].error),
+            };
+            print_fit(&fit);
+            orders.push(fit);
+        }
+    }
+    println!("backend: {backend}");
+    let report = AccuracyReport {
+        backend,
+        quick: opts.quick,
+        runs,
+        orders,
+    };
+    if let Some(dir) = opts.plots {
+        write_plots(Path::new(dir), &report)?;
+    }
+    if let Some(path) = opts.json {
+        super::write_json(path, &report)?;
+    }
+    Ok(())
+}
+
+fn write_plots(dir: &Path, rep: &AccuracyReport) -> Result<(), SpatterError> {
+    let io = |e: String| SpatterError::Runtime(e);
+    std::fs::create_dir_all(dir)
+        .map_err(|e| io(format!("cannot create {}: {e}", dir.display())))?;
+    let mut scenes: Vec<&str> = rep.runs.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    let mut summary = Vec::new();
+    for scene in &scenes {
+        let mut series = Vec::new();
+        for fit in rep.orders.iter().filter(|f| f.scene == *scene) {
+            let points = rep
+                .runs
+                .iter()
+                .filter(|r| r.scene == *scene && r.kernel == fit.kernel)
+                .map(|r| (r.wall_s, r.error, format!("dx {:.2e}", r.dx)))
+                .collect();
+            let order = fit
+                .observed_order
+                .map_or("n/a".into(), |o| format!("{o:.2}"));
+            series.push(Series {
+                label: format!("{} (order {order})", fit.kernel),
+                points,
+            });
+        }
+        let title = format!("{scene}: error against wall time ({})", rep.backend);
+        let path = dir.join(format!("{scene}.png"));
+        let fig = Figure {
+            title: &title,
+            x_label: "wall time (s)",
+            y_label: "error (check metric)",
+            series: &series,
+            guides: &[],
+        };
+        if plot::log_log(&path, &fig).map_err(io)? {
+            println!("wrote {}", path.display());
+        }
+        // A conservation error sits at round-off: it has no order to compare.
+        let converges = rep
+            .orders
+            .iter()
+            .any(|f| f.scene == *scene && f.expected_order.is_some());
+        if converges {
+            summary.push(convergence_series(rep, scene));
+        }
+    }
+    let path = dir.join("summary.png");
+    let guides = [1.0, 2.0].map(|s| Guide {
+        label: format!("order {s:.0}"),
+        slope: s,
+        through: (1.0, 1.0),
+    });
+    let fig = Figure {
+        title: "Convergence: error / error at the coarsest dx (quintic kernel)",
+        x_label: "dx / coarsest dx",
+        y_label: "relative error",
+        series: &summary,
+        guides: &guides,
+    };
+    if plot::log_log(&path, &fig).map_err(io)? {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// A scene's quintic-kernel errors against Δx, both scaled by the coarsest run, so
+/// every scene shares the summary figure's axes.
+fn convergence_series(rep: &AccuracyReport, scene: &str) -> Series {
+    let mine: Vec<&AccuracyRun> = rep
+        .runs
+        .iter()
+        .filter(|r| r.scene == scene && r.kernel == "quintic")
+        .collect();
+    let points = match mine.first() {
+        Some(c) => mine
+            .iter()
+            .map(|r| (r.dx / c.dx, r.error / c.error, String::new()))
+            .collect(),
+        None => Vec::new(),
+    };
+    Series {
+        label: scene.to_string(),
+        points,
+    }
+}

@@ -368,6 +368,16 @@ pub fn run(
         sched = Schedule::new(m, t, out.checkpoint_every);
     }
     progress.finish();
+    // The last chunk can end between two scans: the final state is scanned too, so
+    // a run never completes on a state the watchdog would refuse.
+    let mut fin = None;
+    if trip.is_none() {
+        let st = backend
+            .read_state()
+            .map_err(|e| device_lost(m, out, &last_good, e))?;
+        trip = watchdog::scan(m, &st);
+        fin = Some(st);
+    }
     let final_state = match trip {
         Some(first) => {
             let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
@@ -379,9 +389,7 @@ pub fn run(
             bad
         }
         None => {
-            let fin = backend
-                .read_state()
-                .map_err(|e| device_lost(m, out, &last_good, e))?;
+            let fin = fin.expect("the final state is read when nothing tripped");
             out.frame(m, &fin).map_err(rt)?;
             out.diagnostics(m, &fin).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {

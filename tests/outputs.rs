@@ -420,3 +420,30 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
     let t_max = last["max_temperature"].as_f64().unwrap();
     assert!(t_max > 600.0 && t_max < 700.0, "{last}");
 }
+
+/// The final state is scanned too: a run whose instability starts after the last
+/// scheduled scan does not complete on a state the watchdog refuses. The coarse 3D
+/// dam break (Δx = 4 cm) puts a particle 0.51 Δx into the floor at step 254; with
+/// no frame (hence no scan) inside 300 steps it used to finish with exit 0 and
+/// evaluate its check on that state (found by `bench stability`, random seed 22).
+#[test]
+fn instability_after_the_last_scan_still_stops_the_run() {
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_3d"),
+        "--backend",
+        "cpu",
+        "--steps",
+        "300",
+        "--set",
+        "dx=0.04",
+        "--set",
+        "run.output_interval=1e3",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("unstable at step 254") && stderr.contains("penetrated the z_min wall"),
+        "{stderr}"
+    );
+}

@@ -194,8 +194,8 @@ pub fn generate(seed: u64) -> RandomScene {
         t.push_str(&text);
         kinds.push(kind);
     }
-    // A step budget the runner replaces; a scene needs an end to be valid.
-    let _ = writeln!(t, "\n[run]\nsteps = 1000");
+    // The runner's step budget ends the run first; a scene needs an end to be valid.
+    let _ = writeln!(t, "\n[run]\nsteps = 1000000");
     let axes: Vec<&str> = (0..dim)
         .filter(|&a| periodic[a])
         .map(|a| ["x", "y", "z"][a])

@@ -96,14 +96,22 @@ struct OutputArgs {
 
 #[derive(Subcommand)]
 enum BenchKind {
-    /// 3D dam break at several sizes on each available backend.
+    /// Fluid-only (3D dam break) and heat (line melt) scenes at several sizes on each
+    /// available backend; per-pass times and the cost of each optional pass.
     Throughput {
         /// Write the figures as JSON.
         #[arg(long)]
         json: Option<String>,
-        /// Particle counts to aim for.
-        #[arg(long, value_delimiter = ',', default_values_t = vec![1e4, 1e5, 1e6])]
+        /// Particle counts to aim for (a size that does not fit in memory, or whose
+        /// projected time exceeds 4 minutes on the CPU, is skipped and says so).
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1e4, 1e5, 1e6, 1e7])]
         sizes: Vec<f64>,
+        /// Scenes: dam_break_3d, line_melt (default both).
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<String>,
+        /// Size at which each optional pass is costed by running without it (0: never).
+        #[arg(long, default_value_t = 1e5)]
+        pass_costs_at: f64,
         /// Steps timed per size.
         #[arg(long, default_value_t = 20)]
         steps: u32,
@@ -194,9 +202,19 @@ fn cmd_bench(which: BenchKind) -> Result<ExitCode, SpatterError> {
         BenchKind::Throughput {
             json,
             sizes,
+            scenes,
+            pass_costs_at,
             steps,
             backend,
-        } => bench::throughput(&sizes, steps, &backend, json.as_deref()).map(|_| ExitCode::SUCCESS),
+        } => bench::throughput(&bench::throughput::Options {
+            sizes: &sizes,
+            steps,
+            backends: &backend,
+            scenes: &scenes,
+            pass_costs_at: (pass_costs_at > 0.0).then_some(pass_costs_at),
+            json: json.as_deref(),
+        })
+        .map(|_| ExitCode::SUCCESS),
         BenchKind::Accuracy {
             scenes,
             backend,

@@ -66,6 +66,10 @@ pub trait Backend {
     fn is_software(&self) -> bool;
     /// The stages this scene runs.
     fn pipeline(&self) -> &Pipeline;
+    /// Leave `stage` out of every later step. For `bench throughput` only, which
+    /// measures what an optional pass costs by running the same scene with and
+    /// without it: what the steps then compute is not the scene's physics.
+    fn skip_stage(&mut self, stage: Stage);
     fn run_stage(&mut self, stage: Stage);
     /// Run `n` whole steps without reading anything back.
     fn run_steps(&mut self, n: u32) {

@@ -117,6 +117,9 @@ impl Backend for CpuBackend {
     fn pipeline(&self) -> &Pipeline {
         &self.pipeline
     }
+    fn skip_stage(&mut self, stage: Stage) {
+        self.pipeline.step.retain(|&s| s != stage);
+    }
     fn run_stage(&mut self, stage: Stage) {
         let t0 = Instant::now();
         (stage.def().cpu)(self);

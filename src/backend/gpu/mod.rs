@@ -277,6 +277,9 @@ impl Backend for GpuBackend {
     fn pipeline(&self) -> &Pipeline {
         &self.pipeline
     }
+    fn skip_stage(&mut self, stage: Stage) {
+        self.pipeline.step.retain(|&s| s != stage);
+    }
     fn run_stage(&mut self, stage: Stage) {
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
         let idx = self

@@ -23,11 +23,13 @@ fn num(v: &Value, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("{key} missing in {v}"))
 }
 
-/// The scenes whose quick pair must show the error falling with Δx: the quintic
-/// kernel converges at order 2.0 on both flows and 0.8 on the Stefan front before
-/// its discretisation floor (README, Benchmarks). conduction_1d sits on its floor
-/// already (1.69e-3 → 1.62e-3 from Δx = 1 mm to 0.83 mm) and laser_flat_plate's
-/// energy balance is round-off at every Δx, so neither is held to falling.
+/// Issue 15: for Poiseuille, Couette, conduction_1d and Stefan the error falls with
+/// Δx. Measured (quick pair, quintic, 2026-12-02): Poiseuille 7.96e-3 → 4.49e-3 and
+/// Couette 9.26e-4 → 5.17e-4 (order 2.0), Stefan 4.07e-3 → 3.38e-3 (0.8), and
+/// conduction_1d 1.69e-3 → 1.62e-3: already on its discretisation floor (order 0.2,
+/// README, Benchmarks), so it is held to falling but not to an order.
+const FALLING: [&str; 4] = ["poiseuille_2d", "couette_2d", "stefan_1d", "conduction_1d"];
+/// Those of them whose quick pair must also show an order above ½.
 const CONVERGING: [&str; 3] = ["poiseuille_2d", "couette_2d", "stefan_1d"];
 
 #[test]
@@ -63,15 +65,20 @@ fn accuracy_quick_reports_finite_figures_and_converges() {
         assert!(r["warnings"].as_array().unwrap().is_empty(), "{r}");
         assert!(r["pass"].as_bool().unwrap(), "{r}");
     }
-    for scene in CONVERGING {
-        let fit = v["orders"]
+    let fit = |scene: &str| {
+        v["orders"]
             .as_array()
             .unwrap()
             .iter()
             .find(|f| f["scene"] == scene)
-            .unwrap();
-        assert!(fit["monotone"].as_bool().unwrap(), "{fit}");
-        assert!(num(fit, "observed_order") > 0.5, "{fit}");
+            .unwrap()
+            .clone()
+    };
+    for scene in FALLING {
+        assert!(fit(scene)["monotone"].as_bool().unwrap(), "{}", fit(scene));
+    }
+    for scene in CONVERGING {
+        assert!(num(&fit(scene), "observed_order") > 0.5, "{}", fit(scene));
     }
 }
 

@@ -95,8 +95,9 @@ pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
         .configure_mesh()
         .x_desc(fig.x_label)
         .y_desc(fig.y_label)
-        .x_labels(10)
-        .y_labels(10)
+        // Log axes label their minor ticks too: six keeps a decade's labels apart.
+        .x_labels(6)
+        .y_labels(8)
         .x_label_formatter(&|v| format!("{v:.1e}"))
         .y_label_formatter(&|v| format!("{v:.1e}"))
         .label_style(("sans-serif", 14))

@@ -286,3 +286,26 @@ fn line_melt_example_runs_at_its_quick_look_resolution() {
     let melted = figure(line, "melted volume ");
     assert!(melted > 0.0, "{line}");
 }
+
+/// Issue 18, item 4: a particle without a temperature (adiabatic_box's insulating
+/// walls have none) is written as the scene's ambient temperature, not 0 K, so a
+/// colour scale over a frame spans only the temperatures the scene has.
+#[test]
+fn particles_without_a_temperature_write_the_ambient_temperature() {
+    let l = spatter::run::load(&common::scene("adiabatic_box"), &[]).unwrap();
+    let fields = spatter::output::heat_channels(&l.model, &l.state);
+    let t = fields.iter().find(|f| f.name == "temperature").unwrap();
+    let spatter::output::Values::F32(t) = &t.values else {
+        panic!("temperature is f32")
+    };
+    let insulation = l.model.phase_index("insulation").unwrap() as u32;
+    let mut walls = 0;
+    for (i, &ti) in t.iter().enumerate() {
+        assert!(ti.is_finite() && ti > 1.0, "particle {i}: {ti} K");
+        if l.state.phase[i] == insulation {
+            assert_eq!(ti, l.model.ambient_temperature as f32);
+            walls += 1;
+        }
+    }
+    assert!(walls > 0);
+}

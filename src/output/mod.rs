@@ -113,11 +113,26 @@ pub fn absolute_enthalpy(m: &Model, st: &State, i: usize) -> f64 {
 }
 
 /// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).
+/// A particle of a phase without thermal properties (a wall with no temperature,
+/// which insulates) has no temperature: it is written as the scene's ambient
+/// temperature, with liquid fraction and enthalpy 0, so that a colour scale over
+/// the frame stays within the temperatures the scene has (0 K used to stretch it).
 pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     if st.heat.is_empty() {
         return Vec::new();
     }
-    let col = |k: usize| Values::F32(st.heat.iter().map(|h| h[k]).collect());
+    let ambient = m.ambient_temperature as f32;
+    let has_temperature = |i: usize| m.phases[st.phase[i] as usize].thermal.is_some();
+    let col = |k: usize| {
+        Values::F32(
+            (0..st.len())
+                .map(|i| match (k, has_temperature(i)) {
+                    (1, false) => ambient,
+                    _ => st.heat[i][k],
+                })
+                .collect(),
+        )
+    };
     let enthalpy = Values::F32(
         (0..st.len())
             .map(|i| absolute_enthalpy(m, st, i) as f32)

@@ -340,6 +340,9 @@ fn cmd_run(
             h.pool_length
         );
     }
+    if loaded.model.has_walls_and_fluid() {
+        println!("wall leakage: {}", report.leakage.summary());
+    }
     if profile {
         let times = backend.take_pass_times();
         let steps = report.steps.max(1) as f64;

@@ -115,6 +115,8 @@ pub struct RunReport {
     pub end: RunEnd,
     /// The checkpoint written last, if any.
     pub last_checkpoint: Option<PathBuf>,
+    /// Wall leakage over every state the run read back (issue 18).
+    pub leakage: watchdog::Leakage,
 }
 
 impl RunReport {
@@ -298,6 +300,7 @@ pub fn run(
     let cap = chunk_cap(st.len());
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
+    let mut leakage = watchdog::leakage(m, &st);
     let mut end = RunEnd::Completed;
     while trip.is_none() {
         let t = sim.time as f64;
@@ -352,6 +355,7 @@ pub fn run(
         if trip.is_some() {
             continue;
         }
+        leakage.absorb(watchdog::leakage(m, &st));
         last_good = st.clone();
         if due.1 {
             out.diagnostics(m, &st).map_err(rt)?;
@@ -382,6 +386,7 @@ pub fn run(
         Some(first) => {
             let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
+            leakage.absorb(watchdog::leakage(m, &bad));
             out.frame(m, &bad).map_err(rt)?;
             out.diagnostics(m, &bad).map_err(rt)?;
             out.checkpoint(m, &good).map_err(rt)?;
@@ -390,6 +395,7 @@ pub fn run(
         }
         None => {
             let fin = fin.expect("the final state is read when nothing tripped");
+            leakage.absorb(watchdog::leakage(m, &fin));
             out.frame(m, &fin).map_err(rt)?;
             out.diagnostics(m, &fin).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
@@ -413,6 +419,7 @@ pub fn run(
         final_state,
         end,
         last_checkpoint: out.last_checkpoint.clone(),
+        leakage,
     })
 }
 
@@ -508,6 +515,9 @@ mod tests {
         }
         fn pipeline(&self) -> &Pipeline {
             self.inner.pipeline()
+        }
+        fn skip_stage(&mut self, stage: Stage) {
+            self.inner.skip_stage(stage)
         }
         fn run_stage(&mut self, stage: Stage) {
             self.inner.run_stage(stage)

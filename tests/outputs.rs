@@ -446,4 +446,11 @@ fn instability_after_the_last_scan_still_stops_the_run() {
         stderr.contains("unstable at step 254") && stderr.contains("penetrated the z_min wall"),
         "{stderr}"
     );
+    // The leakage summary names the same particle and face.
+    assert!(
+        stdout.contains(
+            "wall leakage: deepest fluid penetration 0.51 dx (particle 445 behind the z_min wall"
+        ),
+        "{stdout}"
+    );
 }

@@ -135,6 +135,12 @@ impl Model {
             .filter_map(|p| p.thermal)
             .any(|t| t.evaporation.is_some() || t.emissivity > 0.0)
     }
+    /// Closed wall faces and a phase that flows: fluid can leak into the walls.
+    pub fn has_walls_and_fluid(&self) -> bool {
+        let closed = (0..self.dim as usize)
+            .any(|a| !self.periodic[a] && self.open_sides[a].iter().any(|open| !open));
+        closed && self.phases.iter().any(|p| p.is_fluid())
+    }
     pub fn is_thermal(&self) -> bool {
         self.phases.iter().any(|p| p.thermal.is_some())
     }

@@ -170,6 +170,10 @@ pub struct Diagnostics {
     pub min_density: f64,
     pub max_density: f64,
     pub particles: std::collections::BTreeMap<String, u64>,
+    /// Deepest fluid penetration behind a wall face, in Δx (issue 18).
+    pub wall_penetration_max_dx: f64,
+    /// Fluid particles more than ½Δx behind a wall face.
+    pub wall_penetration_count: u64,
     /// Heat scenes only.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub heat: Option<HeatDiagnostics>,
@@ -284,8 +288,12 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         min_density: f64::INFINITY,
         max_density: f64::NEG_INFINITY,
         particles: m.phases.iter().map(|p| (p.name.clone(), 0)).collect(),
+        wall_penetration_max_dx: 0.0,
+        wall_penetration_count: 0,
         heat: heat_diagnostics(m, st),
     };
+    let leak = crate::watchdog::leakage(m, st);
+    (d.wall_penetration_max_dx, d.wall_penetration_count) = (leak.deepest_dx, leak.beyond_half_dx);
     for i in 0..st.len() {
         let phase = &m.phases[st.phase[i] as usize];
         *d.particles.entry(phase.name.clone()).or_default() += 1;
@@ -336,10 +344,14 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             "min_density": num("smallest fluid density, kg/m^3"),
             "max_density": num("largest fluid density, kg/m^3"),
             "particles": {"type": "object", "properties": phases,
-                          "description": "particle count per phase"}
+                          "description": "particle count per phase"},
+            "wall_penetration_max_dx": num("deepest fluid penetration behind a wall face, dx"),
+            "wall_penetration_count": {"type": "integer",
+                                       "description": "fluid particles more than 0.5 dx behind a wall face"}
         },
         "required": ["time", "step", "dt", "dt_limit", "kinetic_energy", "total_mass",
-                     "max_speed", "min_density", "max_density", "particles"]
+                     "max_speed", "min_density", "max_density", "particles",
+                     "wall_penetration_max_dx", "wall_penetration_count"]
     });
     if m.is_thermal() {
         let unit = if m.dim == 2 {

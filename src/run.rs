@@ -301,6 +301,7 @@ pub fn run(
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
     let mut leakage = watchdog::leakage(m, &st);
+    let mut leak_warned = false;
     let mut end = RunEnd::Completed;
     while trip.is_none() {
         let t = sim.time as f64;
@@ -356,6 +357,14 @@ pub fn run(
             continue;
         }
         leakage.absorb(watchdog::leakage(m, &st));
+        if !leak_warned && leakage.beyond_half_dx > 0 && !opts.quiet {
+            leak_warned = true;
+            eprintln!(
+                "warning: fluid leaks into the walls: {}; the run stops at {} dx (watchdog.wall_penetration)",
+                leakage.summary(),
+                m.wall_stop_depth()
+            );
+        }
         last_good = st.clone();
         if due.1 {
             out.diagnostics(m, &st).map_err(rt)?;

@@ -423,9 +423,10 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
 
 /// The final state is scanned too: a run whose instability starts after the last
 /// scheduled scan does not complete on a state the watchdog refuses. The coarse 3D
-/// dam break (Δx = 4 cm) puts a particle 0.51 Δx into the floor at step 254; with
-/// no frame (hence no scan) inside 300 steps it used to finish with exit 0 and
-/// evaluate its check on that state (found by `bench stability`, random seed 22).
+/// dam break (Δx = 4 cm) puts a particle 0.51 Δx into the floor at step 254, which
+/// the strict threshold (0.5 Δx) refuses; with no frame (hence no scan) inside 300
+/// steps it used to finish with exit 0 and evaluate its check on that state (found
+/// by `bench stability`, random seed 22).
 #[test]
 fn instability_after_the_last_scan_still_stops_the_run() {
     let out = spatter(&[
@@ -439,6 +440,8 @@ fn instability_after_the_last_scan_still_stops_the_run() {
         "dx=0.04",
         "--set",
         "run.output_interval=1e3",
+        "--set",
+        "watchdog.wall_penetration=0.5",
     ]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
@@ -453,4 +456,46 @@ fn instability_after_the_last_scan_still_stops_the_run() {
         ),
         "{stdout}"
     );
+}
+
+/// Issue 18, item 2: by default a leak into the wall layers is measured and warned
+/// about, and only a fluid particle through all the layers stops the run. The
+/// coarse 3D dam break leaks 0.54 Δx into the floor at t = 0.125 s (a warning) and
+/// particle 445 comes out under the third layer at step 411.
+#[test]
+fn a_leak_into_the_walls_warns_and_only_a_leak_through_them_stops() {
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_3d"),
+        "--backend",
+        "cpu",
+        "--until",
+        "0.25",
+        "--set",
+        "dx=0.04",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("warning: fluid leaks into the walls"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("unstable at step 411")
+            && stderr.contains("passed through all 3 layers of the z_min wall"),
+        "{stderr}"
+    );
+    assert!(
+        stdout.contains("wall leakage: deepest fluid penetration 3.02 dx (particle 445"),
+        "{stdout}"
+    );
+    let bad = spatter(&[
+        "validate",
+        &common::scene("dam_break_3d"),
+        "--set",
+        "watchdog.wall_penetration=-1",
+    ]);
+    let (_, stderr) = text(&bad);
+    assert_eq!(bad.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("watchdog.wall_penetration"), "{stderr}");
 }

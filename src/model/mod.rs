@@ -135,6 +135,13 @@ impl Model {
             .filter_map(|p| p.thermal)
             .any(|t| t.evaporation.is_some() || t.emissivity > 0.0)
     }
+    /// Depth behind a wall face (in Δx) at which the watchdog stops a run: the
+    /// scene's `watchdog.wall_penetration`, else the whole wall-layer band.
+    pub fn wall_stop_depth(&self) -> f64 {
+        self.watchdog
+            .wall_penetration
+            .unwrap_or(self.wall_layers as f64)
+    }
     /// Closed wall faces and a phase that flows: fluid can leak into the walls.
     pub fn has_walls_and_fluid(&self) -> bool {
         let closed = (0..self.dim as usize)
@@ -336,7 +343,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
-    cx.positive("watchdog.wall_penetration", wd.wall_penetration)?;
+    if let Some(depth) = wd.wall_penetration {
+        cx.positive("watchdog.wall_penetration", depth)?;
+    }
     if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
         return Err(cx.err(
             "watchdog.max_density_ratio",

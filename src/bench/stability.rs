@@ -131,6 +131,8 @@ pub struct CaseResult {
     pub momentum_drift: Option<f64>,
     /// (H_end − H_0)/|H_0|, where the scene conserves enthalpy.
     pub enthalpy_drift: Option<f64>,
+    /// Deepest fluid penetration behind a wall face over the run, in Δx.
+    pub wall_penetration_max_dx: f64,
 }
 
 #[derive(serde::Serialize)]
@@ -429,6 +431,7 @@ fn run_case(c: &Case, dir: &std::path::Path, choice: BackendChoice) -> CaseResul
         mass_drift: f64::NAN,
         momentum_drift: None,
         enthalpy_drift: None,
+        wall_penetration_max_dx: 0.0,
     };
     let t0 = Instant::now();
     let outcome = catch_unwind(AssertUnwindSafe(|| run_and_judge(c, choice, dir, &mut r)));
@@ -482,6 +485,7 @@ fn run_and_judge(
     r.steps = report.steps;
     r.sim_time = report.sim_time;
     r.mass_drift = (mass(st1) - mass(st0)) / mass(st0);
+    r.wall_penetration_max_dx = report.leakage.deepest_dx;
     let keeps = conserves(c, &l.model);
     if keeps.momentum {
         let ((p0, _), (p1, scale)) = (momentum(st0), momentum(st1));
@@ -565,7 +569,7 @@ fn envelope(cases: &[CaseResult]) -> Vec<String> {
 fn print_case(c: &CaseResult) {
     let drift = |d: Option<f64>| d.map_or("-".into(), |v| format!("{v:.1e}"));
     println!(
-        "  {:<9} {:<64} {:<9} {:>6} particles {:>7} steps  t {:.3e} s  {:>7.2} s  mass {:.0e}  momentum {}  enthalpy {}",
+        "  {:<9} {:<64} {:<9} {:>6} particles {:>7} steps  t {:.3e} s  {:>7.2} s  mass {:.0e}  momentum {}  enthalpy {}  leak {:.2} dx",
         c.group,
         c.name,
         c.outcome,
@@ -575,7 +579,8 @@ fn print_case(c: &CaseResult) {
         c.wall_s,
         c.mass_drift,
         drift(c.momentum_drift),
-        drift(c.enthalpy_drift)
+        drift(c.enthalpy_drift),
+        c.wall_penetration_max_dx
     );
     if !c.diagnosis.is_empty() {
         println!("      {}", c.diagnosis);

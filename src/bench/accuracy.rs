@@ -6,7 +6,6 @@
 //! log Δx) is printed beside the order the method should reach.
 
 use super::plot::{self, Figure, Guide, Series};
-use crate::backend::gpu::{AdapterChoice, GpuContext};
 use crate::error::{InputError, SpatterError};
 use crate::model;
 use crate::run::{self, BackendChoice, Loaded, Outputs, RunEnd, RunOptions};
@@ -348,21 +347,9 @@ fn print_fit(f: &OrderFit) {
     );
 }
 
-/// `auto` decided once for the whole sweep: a hardware GPU if there is one, else
-/// the CPU (the software adapter is for bit-match tests, not for benchmarks).
-fn resolve(choice: BackendChoice) -> BackendChoice {
-    match choice {
-        BackendChoice::Auto => match GpuContext::open(AdapterChoice::HardwareOnly, false) {
-            Ok(_) => BackendChoice::Gpu,
-            Err(_) => BackendChoice::Cpu,
-        },
-        c => c,
-    }
-}
-
 pub fn accuracy(opts: &Options) -> Result<(), SpatterError> {
     let sweeps = chosen(opts)?;
-    let choice = resolve(opts.backend);
+    let choice = super::resolve_backend(opts.backend);
     let kernels: &[KernelKind] = if opts.quick { &KERNELS[..1] } else { &KERNELS };
     let mut runs = Vec::new();
     let mut orders = Vec::new();

@@ -10,7 +10,21 @@ pub mod throughput;
 
 pub use throughput::throughput;
 
+use crate::backend::gpu::{AdapterChoice, GpuContext};
 use crate::error::SpatterError;
+use crate::run::BackendChoice;
+
+/// `auto` decided once for a whole benchmark: a hardware GPU if there is one, else
+/// the CPU (the software adapter is for bit-match tests, not for benchmarks).
+pub fn resolve_backend(choice: BackendChoice) -> BackendChoice {
+    match choice {
+        BackendChoice::Auto => match GpuContext::open(AdapterChoice::HardwareOnly, false) {
+            Ok(_) => BackendChoice::Gpu,
+            Err(_) => BackendChoice::Cpu,
+        },
+        c => c,
+    }
+}
 
 /// Peak resident memory of this process since the last `reset_peak_rss`, in bytes
 /// (Linux VmHWM); None where /proc does not say.

@@ -9,7 +9,6 @@
 //! parameter extremes on a few scenes, and seeded random scenes.
 
 use super::random_scene;
-use crate::backend::gpu::{AdapterChoice, GpuContext};
 use crate::checkpoint::{self, CheckpointSink};
 use crate::error::SpatterError;
 use crate::model::{self, EndCondition, Model};
@@ -589,13 +588,7 @@ fn print_case(c: &CaseResult) {
 
 /// Runs the suite; Ok(true) when nothing crashed.
 pub fn stability(opts: &Options) -> Result<bool, SpatterError> {
-    let choice = match opts.backend {
-        BackendChoice::Auto => match GpuContext::open(AdapterChoice::HardwareOnly, false) {
-            Ok(_) => BackendChoice::Gpu,
-            Err(_) => BackendChoice::Cpu,
-        },
-        c => c,
-    };
+    let choice = super::resolve_backend(opts.backend);
     let mut cases = long_runs(opts.quick);
     cases.extend(extremes(opts.quick)?);
     cases.extend(random_cases(opts.quick, opts.seed));

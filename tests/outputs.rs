@@ -421,6 +421,14 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
     assert!(t_max > 600.0 && t_max < 700.0, "{last}");
 }
 
+/// The 3D dam break at Δx = 4 cm on the CPU, with more arguments.
+fn coarse_dam_break_3d(extra: &[&str]) -> std::process::Output {
+    let scene = common::scene("dam_break_3d");
+    let mut args = vec!["run", &scene, "--backend", "cpu", "--set", "dx=0.04"];
+    args.extend_from_slice(extra);
+    spatter(&args)
+}
+
 /// The final state is scanned too: a run whose instability starts after the last
 /// scheduled scan does not complete on a state the watchdog refuses. The coarse 3D
 /// dam break (Δx = 4 cm) puts a particle 0.51 Δx into the floor at step 254, which
@@ -429,15 +437,9 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
 /// by `bench stability`, random seed 22).
 #[test]
 fn instability_after_the_last_scan_still_stops_the_run() {
-    let out = spatter(&[
-        "run",
-        &common::scene("dam_break_3d"),
-        "--backend",
-        "cpu",
+    let out = coarse_dam_break_3d(&[
         "--steps",
         "300",
-        "--set",
-        "dx=0.04",
         "--set",
         "run.output_interval=1e3",
         "--set",
@@ -464,16 +466,7 @@ fn instability_after_the_last_scan_still_stops_the_run() {
 /// particle 445 comes out under the third layer at step 411.
 #[test]
 fn a_leak_into_the_walls_warns_and_only_a_leak_through_them_stops() {
-    let out = spatter(&[
-        "run",
-        &common::scene("dam_break_3d"),
-        "--backend",
-        "cpu",
-        "--until",
-        "0.25",
-        "--set",
-        "dx=0.04",
-    ]);
+    let out = coarse_dam_break_3d(&["--until", "0.25"]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
     assert!(

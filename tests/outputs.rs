@@ -421,7 +421,9 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
     assert!(t_max > 600.0 && t_max < 700.0, "{last}");
 }
 
-/// The 3D dam break at Δx = 4 cm on the CPU, with more arguments.
+/// The 3D dam break at Δx = 4 cm on the CPU, with more arguments. 0.1/0.04 is not a
+/// whole number: the column and tank leave half-spacing gaps (warned about), and
+/// the coarse column leaks into the walls early, which makes it a watchdog case.
 fn coarse_dam_break_3d(extra: &[&str]) -> std::process::Output {
     let scene = common::scene("dam_break_3d");
     let mut args = vec!["run", &scene, "--backend", "cpu", "--set", "dx=0.04"];

@@ -40,7 +40,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=6.666666666666667e-5"],
     ),
     (scene_file!("validation/dam_break_2d"), &["dx=0.01"]),
-    (scene_file!("validation/dam_break_3d"), &["dx=0.04"]),
+    (scene_file!("validation/dam_break_3d"), &["dx=0.02"]),
     (scene_file!("validation/dam_break_air_2d"), &["dx=0.01"]),
     (scene_file!("validation/dam_break_gate_2d"), &["dx=0.01"]),
     (scene_file!("validation/hydrostatic_2d"), &["dx=0.025"]),
@@ -132,6 +132,8 @@ pub struct CaseResult {
     pub enthalpy_drift: Option<f64>,
     /// Deepest fluid penetration behind a wall face over the run, in Δx.
     pub wall_penetration_max_dx: f64,
+    /// Scene warnings at this resolution (a box that does not fill whole rows).
+    pub warnings: Vec<String>,
 }
 
 #[derive(serde::Serialize)]
@@ -431,6 +433,7 @@ fn run_case(c: &Case, dir: &std::path::Path, choice: BackendChoice) -> CaseResul
         momentum_drift: None,
         enthalpy_drift: None,
         wall_penetration_max_dx: 0.0,
+        warnings: Vec::new(),
     };
     let t0 = Instant::now();
     let outcome = catch_unwind(AssertUnwindSafe(|| run_and_judge(c, choice, dir, &mut r)));
@@ -462,6 +465,7 @@ fn run_and_judge(
     r: &mut CaseResult,
 ) -> Result<(), String> {
     let l = load(c).map_err(|e| format!("scene rejected: {e}"))?;
+    r.warnings = l.model.warnings.clone();
     let _ = std::fs::remove_dir_all(dir);
     std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     let mut backend = run::make_backend(choice, &l, false).map_err(|e| e.to_string())?;
@@ -583,6 +587,9 @@ fn print_case(c: &CaseResult) {
     );
     if !c.diagnosis.is_empty() {
         println!("      {}", c.diagnosis);
+    }
+    for w in &c.warnings {
+        println!("      warning: {w}");
     }
 }
 

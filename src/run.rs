@@ -32,8 +32,16 @@ pub struct Loaded {
 }
 
 pub fn load(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
-    let (scene, resolved) = scene::load(path, sets)?;
-    let model = model::build(path, &scene, &resolved)?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read scenario: {e}")))?;
+    load_str(path, &text, sets)
+}
+
+/// A scene from scenario text (named `label` in messages): the benchmarks' scenes
+/// are compiled into the binary.
+pub fn load_str(label: &str, text: &str, sets: &[String]) -> Result<Loaded, InputError> {
+    let (scene, resolved) = scene::parse_str(label, text, sets)?;
+    let model = model::build(label, &scene, &resolved)?;
     let state = setup::generate(&model, &scene)?;
     Ok(Loaded { model, state })
 }

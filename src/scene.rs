@@ -454,13 +454,6 @@ impl CheckKind {
     }
 }
 
-/// Read a scenario file, apply `--set` overrides and parse it strictly.
-pub fn load(path: &str, overrides: &[String]) -> Result<(SceneFile, String), InputError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(path, "", format!("cannot read scenario: {e}")))?;
-    parse_str(path, &text, overrides)
-}
-
 /// Parse scenario text (named `file` in messages). Returns the scene and the resolved
 /// TOML text after overrides, which is what a run records for reproduction.
 pub fn parse_str(

@@ -7,9 +7,8 @@
 
 use super::plot::{self, Figure, Guide, Series};
 use crate::error::{InputError, SpatterError};
-use crate::model;
 use crate::run::{self, BackendChoice, Loaded, Outputs, RunEnd, RunOptions};
-use crate::scene::{self, KernelKind};
+use crate::scene::KernelKind;
 use crate::setup;
 use std::path::Path;
 
@@ -234,10 +233,7 @@ fn load(sw: &Sweep, kernel: KernelKind, cells: u32) -> Result<Loaded, SpatterErr
         format!("kernel={}", kernel_key(kernel)),
     ];
     let label = format!("scenarios/validation/{}.toml", sw.name);
-    let (sc, resolved) = scene::parse_str(&label, sw.text, &sets)?;
-    let model = model::build(&label, &sc, &resolved)?;
-    let state = setup::generate(&model, &sc)?;
-    Ok(Loaded { model, state })
+    Ok(run::load_str(&label, sw.text, &sets)?)
 }
 
 fn run_one(

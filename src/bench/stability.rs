@@ -16,7 +16,7 @@ use crate::output::mcap_out::{McapSink, Provenance};
 use crate::run::{self, BackendChoice, Loaded, Outputs, RunEnd, RunOptions};
 use crate::scene::CheckKind;
 use crate::state::State;
-use crate::{scene, setup, watchdog};
+use crate::{scene, watchdog};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Instant;
 
@@ -297,24 +297,19 @@ fn random_cases(quick: bool, seed: u64) -> Vec<Case> {
 }
 
 fn load(c: &Case) -> Result<Loaded, SpatterError> {
-    let build = |sets: &[String]| -> Result<(model::Model, scene::SceneFile), SpatterError> {
-        let (sc, resolved) = scene::parse_str(&c.label, &c.text, sets)?;
-        Ok((model::build(&c.label, &sc, &resolved)?, sc))
-    };
-    let (mut model, mut sc) = build(&c.sets)?;
+    let l = run::load_str(&c.label, &c.text, &c.sets)?;
+    if l.model.output_interval.is_finite() {
+        return Ok(l);
+    }
     // A scene that ends after a step count has no output interval: give it ten
     // frames (and watchdog scans) over the case's budget.
-    if !model.output_interval.is_finite() {
-        let dt = model.fixed_dt.unwrap_or(model.limits.min().0);
-        let mut sets = c.sets.clone();
-        sets.push(format!(
-            "run.output_interval={:e}",
-            dt * (c.max_steps as f64 / 10.0).max(1.0)
-        ));
-        (model, sc) = build(&sets)?;
-    }
-    let state = setup::generate(&model, &sc)?;
-    Ok(Loaded { model, state })
+    let dt = l.model.fixed_dt.unwrap_or(l.model.limits.min().0);
+    let mut sets = c.sets.clone();
+    sets.push(format!(
+        "run.output_interval={:e}",
+        dt * (c.max_steps as f64 / 10.0).max(1.0)
+    ));
+    Ok(run::load_str(&c.label, &c.text, &sets)?)
 }
 
 /// The scene's own end, or `max` steps if that comes first (judged by the initial Δt).

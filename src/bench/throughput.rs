@@ -113,11 +113,11 @@ pub struct Options<'a> {
 }
 
 fn load_at(s: &BenchScene, dx: f64) -> Result<Loaded, SpatterError> {
-    let sets = [format!("dx={dx}")];
-    let (sc, resolved) = scene::parse_str(s.label, s.text, &sets)?;
-    let model = model::build(s.label, &sc, &resolved)?;
-    let state = setup::generate(&model, &sc)?;
-    Ok(Loaded { model, state })
+    Ok(crate::run::load_str(
+        s.label,
+        s.text,
+        &[format!("dx={dx}")],
+    )?)
 }
 
 /// Δx that gives about `target` particles: scaled by the cube root of the count

@@ -10,7 +10,7 @@
 @compute @workgroup_size(64)
 fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph_i = phase[i];
     if (is_wall(ph_i)) { return; }
     let rho0_i = P.phases[ph_i].rho0;

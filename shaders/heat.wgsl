@@ -22,7 +22,7 @@ fn heat_density(ph: u32, i: u32) -> f32 {
 @compute @workgroup_size(64)
 fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (conducts(ph) || (heat_flags(ph) & HEAT_DIRICHLET) == 0u) { return; }
     let pi = pos[i];
@@ -51,7 +51,7 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
 @compute @workgroup_size(64)
 fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph_i = phase[i];
     if (!conducts(ph_i)) { return; }
     let k_i = conductivity(ph_i, heat[i].z);
@@ -117,7 +117,7 @@ fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
 @compute @workgroup_size(64)
 fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     var hv = heat[i];

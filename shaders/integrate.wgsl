@@ -5,7 +5,7 @@
 @compute @workgroup_size(64)
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     let dt = sim.dt;
     if (is_wall(ph)) {
@@ -30,7 +30,18 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         x[c] = wrap_periodic(x[c] + dt * (v[c] + hdt * ab[c]), c);
     }
     vel[i] = v;
-    pos[i] = x;
+    pos[i] = stamp_if_left(x);
+}
+
+// A fluid particle that has just left the keep box carries the time it left in
+// w; the neighbour pass then sorts it last and the passes stop before it (issue
+// 18). Walls are never removed.
+fn stamp_if_left(x: vec4<f32>) -> vec4<f32> {
+    var y = x;
+    if (outside_keep_box(x)) {
+        y.w = sim.time + sim.dt;
+    }
+    return y;
 }
 
 // Brings coordinate x of axis c back into [0, period) on a periodic axis.
@@ -48,7 +59,7 @@ fn wrap_periodic(x: f32, c: u32) -> f32 {
 @compute @workgroup_size(64)
 fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     if (is_wall(phase[i])) { return; }
     let hdt = c_half() * sim.dt;
     let a = acc[i];

@@ -21,7 +21,7 @@ fn volume(j: u32) -> f32 {
 fn shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     let n = P.sizes.n_particles;
-    if (i >= n) { return; }
+    if (i >= active_particles()) { return; }
     var g = 0.0;
     if (condensed(phase[i])) {
         let pi = pos[i];
@@ -84,7 +84,7 @@ fn gas_interface(i: u32) {
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     let n = P.sizes.n_particles;
-    if (i >= n) { return; }
+    if (i >= active_particles()) { return; }
     if ((P.sizes.flags & FLAG_GAS_INTERFACE) != 0u) {
         gas_interface(i);
         return;

@@ -125,7 +125,7 @@ fn bin_axis(k: i32, a: u32) -> i32 {
 @compute @workgroup_size(64)
 fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     if (absorbs(ph)) {
@@ -172,7 +172,7 @@ fn binned_source(i: u32, ph: u32) -> f32 {
 @compute @workgroup_size(64)
 fn laser_surface(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     if (!absorbs(ph)) {

@@ -1,7 +1,8 @@
 // uses: params bindings grid phase
-// writes: keys cell_start cell_end s_pos s_vel s_acc s_acc_b s_mass s_phase s_id s_heat
+// writes: keys cell_start cell_end s_pos s_vel s_acc s_acc_b s_mass s_phase s_id s_heat sim
 // Neighbour search. Twin of src/backend/cpu/neighbors.rs.
-// 1. cell_keys: key (cell, index) per particle; padding keys sort last.
+// 1. cell_keys: key (cell, index) per particle; a particle that has left the
+//    domain gets cell n_cells (after every cell), padding keys sort last.
 // 2. bitonic sort over the padded keys. Keys are unique, so the result is the single
 //    sorted order (stable by index). Stages whose pairs lie inside one block of
 //    SORT_BLOCK keys run in workgroup memory (bitonic_local, many stages per
@@ -10,7 +11,8 @@
 //    passes and 14 local ones instead of 300 global ones.
 // 3. reorder: gather every particle array into scratch in sorted order
 //    (the host copies scratch back).
-// 4. cell_bounds: start/end of each cell's run of sorted particles.
+// 4. cell_bounds: start/end of each cell's run of sorted particles, and the
+//    number of removed particles (sim.removed).
 
 // One sort dispatch: bitonic_global runs stage (j, k); bitonic_local runs, for every
 // k from k to k_last (doubling), the stages j = min(k/2, SORT_BLOCK/2) down to 1.
@@ -44,7 +46,15 @@ fn cell_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let i = thread_index(gid, nwg);
     if (i >= arrayLength(&keys)) { return; }
     if (i < P.sizes.n_particles) {
-        keys[i] = vec2<u32>(cell_index(cell_coord(pos[i])), i);
+        // A fluid particle outside the keep box has left: its key, n_cells, sorts
+        // it after every cell and keeps it out of the cell table (issue 18). Walls
+        // stay, wherever they stand (those of a closed side reach past the open
+        // face above it).
+        var c = P.sizes.n_cells;
+        if (is_wall(phase[i]) || !outside_keep_box(pos[i])) {
+            c = cell_index(cell_coord(pos[i]));
+        }
+        keys[i] = vec2<u32>(c, i);
     } else {
         keys[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
     }
@@ -109,6 +119,17 @@ fn cell_bounds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let n = P.sizes.n_particles;
     if (k >= n) { return; }
     let c = keys[k].x;
+    let gone = P.sizes.n_cells;
+    // The removed particles are the last run of keys: its first one counts them.
+    if (c == gone) {
+        if (k == 0u || keys[k - 1u].x != gone) {
+            sim.removed = n - k;
+        }
+        return;
+    }
+    if (k == n - 1u) {
+        sim.removed = 0u;
+    }
     if (k == 0u || keys[k - 1u].x != c) {
         cell_start[c] = k;
     }

@@ -1,4 +1,4 @@
-// uses: params bindings consts phase
+// uses: params bindings consts grid phase
 // writes: sim partials
 // Max |u|² and |a|² over fluid particles by a fixed two-level tree (per-workgroup,
 // then one workgroup over the partials), then the F22 (42) time step.
@@ -22,7 +22,7 @@ fn reduce(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id) wid: v
     let g = wid.x + wid.y * nwg.x;
     let i = g * RWG + t;
     var m = vec2<f32>(0.0, 0.0);
-    if (i < P.sizes.n_particles && !is_wall(phase[i])) {
+    if (i < active_particles() && !is_wall(phase[i])) {
         let v = vel[i];
         let a = acc[i];
         m = vec2<f32>(v.x * v.x + v.y * v.y + v.z * v.z, a.x * a.x + a.y * a.y + a.z * a.z);

@@ -6,7 +6,7 @@
 @compute @workgroup_size(64)
 fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
-    if (i >= P.sizes.n_particles) { return; }
+    if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (!is_wall(ph)) { return; }
     let pi = pos[i];

@@ -12,6 +12,7 @@ pub mod gpu_layout;
 pub mod inspect;
 pub mod kernel;
 pub mod model;
+pub mod outflow;
 pub mod output;
 pub mod params;
 pub mod portable_math;

@@ -343,6 +343,12 @@ fn cmd_run(
     if loaded.model.has_walls_and_fluid() {
         println!("wall leakage: {}", report.leakage.summary());
     }
+    let fin = &report.final_state;
+    if fin.sim.removed > 0 || loaded.model.open_sides.iter().flatten().any(|&o| o) {
+        use spatter::outflow::{MassBalance, Outflow};
+        println!("outflow: {}", Outflow::of(&loaded.model, fin).summary());
+        println!("mass: {}", MassBalance::of(&loaded.state, fin).summary());
+    }
     if profile {
         let times = backend.take_pass_times();
         let steps = report.steps.max(1) as f64;

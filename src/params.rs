@@ -71,6 +71,12 @@ gpu_struct! {
         pub period: [f32; 4],
         /// Half the period per axis, for the minimum-image test.
         pub half_period: [f32; 4],
+        /// A particle below `keep_lo` or above `keep_hi` on an axis has left the
+        /// simulation (issue 18): at an open face, or (wall_layers + 1) Δx behind a
+        /// walled one, the edge of the padded box; ±f32::MAX on periodic and
+        /// absent axes.
+        pub keep_lo: [f32; 4],
+        pub keep_hi: [f32; 4],
     }
 }
 
@@ -433,6 +439,13 @@ impl Params {
     pub fn flag(&self, bit: u32) -> bool {
         self.sizes.flags & bit != 0
     }
+    /// Outside the box a particle must stay in: it has left (issue 18). Twin of
+    /// `outside_keep_box` in shaders/lib/grid.wgsl.
+    #[inline(always)]
+    pub fn outside_keep_box(&self, p: &[f32; 4]) -> bool {
+        let (lo, hi) = (&self.grid.keep_lo, &self.grid.keep_hi);
+        p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] || p[2] > hi[2]
+    }
     /// Axis a is periodic.
     pub fn periodic(&self, a: usize) -> bool {
         self.sizes.flags & (FLAG_PERIODIC_X << a) != 0
@@ -499,6 +512,9 @@ fn grid_block(m: &Model) -> Grid {
             g.period[a] = len as f32;
             g.half_period[a] = (0.5 * len) as f32;
         }
+        let (lo, hi) = m.keep_box(a);
+        g.keep_lo[a] = lo as f32;
+        g.keep_hi[a] = hi as f32;
     }
     g
 }

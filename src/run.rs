@@ -163,7 +163,10 @@ impl Outputs {
         }
         self.last_diag_step = Some(st.sim.step);
         match self.mcap.as_mut() {
-            Some(s) => s.diagnostics(&output::diagnostics(m, st)),
+            Some(s) => {
+                s.removals(m, st)?;
+                s.diagnostics(&output::diagnostics(m, st))
+            }
             None => Ok(()),
         }
     }
@@ -472,7 +475,8 @@ fn replay_to_trip(
     for _ in 0..span {
         backend.run_steps(1);
         let st = backend.read_state()?;
-        if let Some(t) = watchdog::check_sim(m, &st.sim).or_else(|| watchdog::scan(m, &st)) {
+        // The scan first: it names the particle where check_sim only counts.
+        if let Some(t) = watchdog::scan(m, &st).or_else(|| watchdog::check_sim(m, &st.sim)) {
             return Ok((t, st, good));
         }
         good = st;

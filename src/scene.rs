@@ -198,9 +198,24 @@ pub struct Domain {
     #[serde(default)]
     pub wall_sides: BTreeMap<String, String>,
     /// Sides left open (no wall layers), e.g. ["z_max"] above a free surface.
-    /// Particles may leave through them; the cell grid clamps them into its edge cells.
+    /// A particle that crosses one leaves the simulation (see `open_sides_policy`).
     #[serde(default)]
     pub open_sides: Vec<String>,
+    /// What a particle crossing an open side does to the run.
+    #[serde(default)]
+    pub open_sides_policy: OpenSidesPolicy,
+}
+
+/// `domain.open_sides_policy` (issue 18).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OpenSidesPolicy {
+    /// The particle is taken out of the simulation, counted with its mass, and
+    /// the run goes on (what DualSPHysics calls excluded particles).
+    #[default]
+    Remove,
+    /// The run stops (exit 3) at the first particle that leaves, naming it.
+    Stop,
 }
 
 /// Names of the domain sides, by axis then (min, max).
@@ -305,6 +320,9 @@ pub struct ShapeDef {
     pub box_: Option<BoxDef>,
     pub sphere: Option<SphereDef>,
     pub cylinder: Option<CylinderDef>,
+    /// Initial velocity of the shape's particles (m/s; liquid and gas phases
+    /// only): a jet, a droplet in flight. Absent: at rest.
+    pub velocity: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -166,6 +166,22 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
                 .collect();
             (lo, hi, "cylinder")
         };
+        if let Some(v) = &s.velocity {
+            if !vec_ok(v) {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("velocity"),
+                    format!("needs {dim} finite components (m/s)"),
+                ));
+            }
+            if !m.phases[pi].is_fluid() {
+                return Err(InputError::new(
+                    &m.file,
+                    &key("velocity"),
+                    format!("phase `{}` does not flow: only liquid and gas shapes start moving (a moving wall takes its phase's velocity)", s.phase),
+                ));
+            }
+        }
         // A fluid shape must lie in the domain: particles outside would start in the walls.
         if m.phases[pi].kind != crate::scene::PhaseKind::Wall {
             let tol = 1e-9 * m.dx;
@@ -252,8 +268,8 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         for (iy, &(y, wy)) in axes[1].iter().enumerate() {
             for (ix, &(x, wx)) in axes[0].iter().enumerate() {
                 let p = [x, y, z];
-                let phase = if wx || wy || wz {
-                    wall_phase_at(m, scene, p)
+                let (phase, shape) = if wx || wy || wz {
+                    (wall_phase_at(m, scene, p), None)
                 } else {
                     scene
                         .shapes
@@ -261,7 +277,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                         .zip(&shape_phase)
                         .rev()
                         .find(|(s, _)| inside(s, p, m.dim as usize))
-                        .map(|(_, &pi)| pi)
+                        .map_or((None, None), |(s, &pi)| (Some(pi), Some(s)))
                 };
                 let Some(pi) = phase else { continue };
                 let mut q = p;
@@ -271,6 +287,12 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                     }
                 }
                 push_particle(m, &mut st, q, pi);
+                if let Some(v) = shape.and_then(|s| s.velocity.as_ref()) {
+                    let last = st.vel.len() - 1;
+                    for (a, c) in v.iter().enumerate() {
+                        st.vel[last][a] = *c as f32;
+                    }
+                }
                 sites.push([ix as u32, iy as u32, iz as u32]);
             }
         }

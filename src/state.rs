@@ -14,7 +14,11 @@ pub struct Sim {
     pub dt_limit: u32,
     pub umax2: f32,
     pub amax2: f32,
-    pub _pad: [u32; 2],
+    /// Particles taken out of the simulation (issue 18): the neighbour pass sorts
+    /// them after every cell, so they are the last `removed` of the arrays, and
+    /// every other pass stops at `n − removed`. Counted by that pass each step.
+    pub removed: u32,
+    pub _pad: u32,
 }
 
 pub const DT_LIMIT_NAMES: [&str; 5] = ["acoustic", "viscous", "force", "fixed", "conduction"];
@@ -29,7 +33,8 @@ pub fn dt_limit_name(code: u32) -> &'static str {
 
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct State {
-    /// Position relative to the grid origin (xyz, w unused).
+    /// Position relative to the grid origin (xyz); w is 0, or for a removed
+    /// particle the time it left the domain.
     pub pos: Vec<[f32; 4]>,
     /// Velocity of fluids; for walls, the velocity the wall pass extrapolated.
     pub vel: Vec<[f32; 4]>,
@@ -66,6 +71,11 @@ impl State {
     }
     pub fn is_empty(&self) -> bool {
         self.pos.is_empty()
+    }
+    /// Particles still in the simulation: indices 0..active(); the removed ones
+    /// follow, frozen where they left, the time they left in `pos[i][3]`.
+    pub fn active(&self) -> usize {
+        self.len() - (self.sim.removed as usize).min(self.len())
     }
     /// The compared fields this state holds, in registry order (crate::fields).
     pub fn fields(&self) -> Vec<FieldView<'_>> {

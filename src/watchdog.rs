@@ -7,7 +7,7 @@
 //! noticed it.
 
 use crate::model::Model;
-use crate::scene::PhaseKind;
+use crate::scene::{OpenSidesPolicy, PhaseKind};
 use crate::state::{Sim, State};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -34,10 +34,21 @@ impl Trip {
     }
 }
 
-/// Δt not finite, not positive or collapsed below the floor.
+/// Δt not finite, not positive or collapsed below the floor; or, when the scene's
+/// open sides stop the run, a particle has left (the scan then names it).
 pub fn check_sim(m: &Model, sim: &Sim) -> Option<Trip> {
     let floor = m.watchdog.min_dt_ratio * m.limits.min().0;
     let dt = sim.dt as f64;
+    if m.open_sides_policy == OpenSidesPolicy::Stop && sim.removed > 0 {
+        return Some(Trip {
+            step: sim.step as u64,
+            time: sim.time as f64,
+            particle: None,
+            field: "removed".into(),
+            value: sim.removed as f64,
+            reason: "particles left the domain and domain.open_sides_policy is \"stop\"".into(),
+        });
+    }
     let reason = if !dt.is_finite() {
         "time step is not finite".to_string()
     } else if dt <= 0.0 {
@@ -106,6 +117,9 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
         }
     }
     let phase = &m.phases[st.phase[i] as usize];
+    if i >= st.active() {
+        return removal_problem(m, st, i);
+    }
     if phase.kind == PhaseKind::Wall {
         return None;
     }
@@ -191,7 +205,7 @@ pub fn leakage(m: &Model, st: &State) -> Leakage {
         time: st.sim.time as f64,
         ..Leakage::default()
     };
-    for i in 0..st.len() {
+    for i in 0..st.active() {
         if !m.phases[st.phase[i] as usize].is_fluid() {
             continue;
         }
@@ -210,32 +224,79 @@ pub fn leakage(m: &Model, st: &State) -> Leakage {
     l
 }
 
-/// A fluid particle behind a wall face, or far outside the domain through an open side.
+/// A fluid particle still in the simulation deeper behind a wall face than the
+/// watchdog allows. (One beyond an open face has been removed by the step.)
 fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
     let depth = m.wall_stop_depth() * m.dx;
     for (a, side, beyond, open) in beyond_faces(m, st, i) {
-        // Through an open side, a splash may leave; one domain length out it is lost.
-        let limit = if open {
-            m.domain_hi[a] - m.domain_lo[a]
-        } else {
-            depth
-        };
-        if beyond <= limit {
+        if open || beyond <= depth {
             continue;
         }
+        return Some(wall_trip(m, st, i, a, side, beyond));
+    }
+    None
+}
+
+fn wall_trip(
+    m: &Model,
+    st: &State,
+    i: usize,
+    a: usize,
+    side: usize,
+    beyond: f64,
+) -> (&'static str, f64, String) {
+    let name = crate::scene::SIDE_NAMES[a][side];
+    let d = beyond / m.dx;
+    let what = match m.watchdog.wall_penetration {
+        Some(t) if t < m.wall_layers as f64 => format!(
+            "penetrated the {name} wall by {d:.2} dx, beyond watchdog.wall_penetration = {t}"
+        ),
+        _ => format!(
+            "passed through all {} layers of the {name} wall ({d:.2} dx behind its face)",
+            m.wall_layers
+        ),
+    };
+    (AXES[a], st.pos[i][a] as f64 + m.origin[a], what)
+}
+
+/// The face a removed particle left through: the one it is farthest beyond
+/// (open or walled), by axis and side. The step decides removal in f32 against the
+/// same faces, so a particle within rounding of a face is still given that face.
+pub fn exit_face(m: &Model, st: &State, i: usize) -> (usize, usize, bool) {
+    let mut best = (0, 0, f64::NEG_INFINITY, false);
+    for a in (0..m.dim as usize).filter(|&a| !m.periodic[a]) {
+        let x = st.pos[i][a] as f64 + m.origin[a];
+        let (lo, hi) = m.keep_box(a);
+        let (lo, hi) = (lo + m.origin[a], hi + m.origin[a]);
+        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
+            if beyond > best.2 {
+                best = (a, side, beyond, m.open_sides[a][side]);
+            }
+        }
+    }
+    (best.0, best.1, best.3)
+}
+
+/// A particle the step removed (issue 18): leaving through an open side is normal
+/// unless the scene's policy is "stop"; leaving behind a walled side means it went
+/// through every wall layer, which always stops the run.
+fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
+    let (a, side, open) = exit_face(m, st, i);
+    let x = st.pos[i][a] as f64 + m.origin[a];
+    if !open {
+        let face = [m.domain_lo[a], m.domain_hi[a]][side];
+        return Some(wall_trip(m, st, i, a, side, (x - face).abs()));
+    }
+    if m.open_sides_policy == OpenSidesPolicy::Stop {
         let name = crate::scene::SIDE_NAMES[a][side];
-        let d = beyond / m.dx;
-        let what = match (open, m.watchdog.wall_penetration) {
-            (true, _) => format!("left the domain through its open {name} side"),
-            (false, Some(t)) => format!(
-                "penetrated the {name} wall by {d:.2} dx, beyond watchdog.wall_penetration = {t}"
+        return Some((
+            AXES[a],
+            x,
+            format!(
+                "left the domain through its open {name} side at t = {:.6e} s (domain.open_sides_policy = \"stop\")",
+                st.pos[i][3]
             ),
-            (false, None) => format!(
-                "passed through all {} layers of the {name} wall ({d:.2} dx behind its face)",
-                m.wall_layers
-            ),
-        };
-        return Some((AXES[a], st.pos[i][a] as f64 + m.origin[a], what));
+        ));
     }
     None
 }

@@ -5,13 +5,15 @@ Set up its environment once (from the repository root):
     python3 -m venv .venv && .venv/bin/pip install -r tools/requirements.txt
 
 Commands:
-    spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span
+    spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span, removals
     spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
     spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
     spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
 
 As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
-(time, {field: numpy array}); read_vtu(path) -> {field: numpy array}.
+(time, {field: numpy array}) of the particles still in the simulation;
+info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
+speed, mass); read_vtu(path) -> {field: numpy array}.
 A file whose writer was killed (no summary) is read up to its last complete chunk.
 """
 import json
@@ -80,7 +82,7 @@ def _messages(path):
 
 
 def read_mcap(path):
-    frames, diagnostics = [], []
+    frames, diagnostics, removed = [], [], []
     info = {"schemas": {}, "metadata": {}}
     for schema, channel, message, decoded in _messages(path):
         info["schemas"][channel.topic] = schema.name if schema else ""
@@ -88,6 +90,9 @@ def read_mcap(path):
             frames.append((message.log_time * 1e-9, pointcloud_to_arrays(decoded)))
         elif channel.topic == "/diagnostics":
             diagnostics.append(decoded)
+        elif channel.topic == "/removed":
+            removed.append(decoded)
+    info["removed"] = sorted(removed, key=lambda r: (r["time"], r["id"]))
     info["complete"] = is_complete(path)
     info["metadata"] = read_metadata(path)
     return frames, diagnostics, info
@@ -145,6 +150,9 @@ def summary(path):
         "diagnostics_max": {k: max(d[k] for d in diagnostics)
                             for k, v in (diagnostics[0].items() if diagnostics else [])
                             if isinstance(v, (int, float))},
+        "removed": len(info["removed"]),
+        "removed_by_side": {side: sum(1 for r in info["removed"] if r["side"] == side)
+                            for side in sorted({r["side"] for r in info["removed"]})},
         "schemas": info["schemas"],
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),

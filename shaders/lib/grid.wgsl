@@ -8,6 +8,19 @@ fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
 }
 
+// Particles still in the simulation: the removed ones sit after them, sorted
+// last by the neighbour pass (issue 18); every other pass stops here.
+fn active_particles() -> u32 {
+    return P.sizes.n_particles - sim.removed;
+}
+
+// Outside the box a particle must stay in (issue 18): it has left.
+fn outside_keep_box(p: vec4<f32>) -> bool {
+    let lo = P.grid.keep_lo;
+    let hi = P.grid.keep_hi;
+    return p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y || p.z < lo.z || p.z > hi.z;
+}
+
 fn cell_coord(p: vec4<f32>) -> vec3<i32> {
     var c: vec3<i32>;
     for (var a = 0u; a < 3u; a++) {

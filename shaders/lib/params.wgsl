@@ -15,6 +15,8 @@ struct Grid {
     cell_inv: vec4<f32>,     // 1 / cell size per axis
     period: vec4<f32>,       // period length per axis (0 where not periodic)
     half_period: vec4<f32>,
+    keep_lo: vec4<f32>,      // below keep_lo or above keep_hi: left (issue 18)
+    keep_hi: vec4<f32>,
 }
 
 struct Kernel {
@@ -170,8 +172,8 @@ struct Sim {
     dt_limit: u32,
     umax2: f32,
     amax2: f32,
+    removed: u32,            // particles taken out, sorted last (issue 18)
     pad0: u32,
-    pad1: u32,
 }
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;

@@ -77,6 +77,7 @@ pub struct Model {
     pub periodic: [bool; 3],
     /// Sides without wall layers, by axis then (min, max).
     pub open_sides: [[bool; 2]; 3],
+    pub open_sides_policy: crate::scene::OpenSidesPolicy,
     pub grid: [u32; 3],
     pub cell_size: [f64; 3],
     pub wall_layers: u32,
@@ -141,6 +142,26 @@ impl Model {
         self.watchdog
             .wall_penetration
             .unwrap_or(self.wall_layers as f64)
+    }
+    /// The box a particle must stay in along axis `a`, grid-relative: an open
+    /// face bounds it; behind a walled face, the edge of the grid's padding
+    /// ((wall_layers + 1) Δx, one layer past the walls, so a leak through every
+    /// layer is seen by the watchdog before the particle is gone). Unbounded on
+    /// periodic and absent axes.
+    pub fn keep_box(&self, a: usize) -> (f64, f64) {
+        if a >= self.dim as usize || self.periodic[a] {
+            return (-(f32::MAX as f64), f32::MAX as f64);
+        }
+        let pad = (self.wall_layers as f64 + 1.0) * self.dx;
+        let (lo, hi) = (
+            self.domain_lo[a] - self.origin[a],
+            self.domain_hi[a] - self.origin[a],
+        );
+        let [open_lo, open_hi] = self.open_sides[a];
+        (
+            if open_lo { lo } else { lo - pad },
+            if open_hi { hi } else { hi + pad },
+        )
     }
     /// Closed wall faces and a phase that flows: fluid can leak into the walls.
     pub fn has_walls_and_fluid(&self) -> bool {
@@ -378,6 +399,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         origin,
         periodic,
         open_sides: open_side_flags(scene),
+        open_sides_policy: scene.domain.open_sides_policy,
         grid,
         cell_size,
         wall_layers,

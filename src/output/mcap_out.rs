@@ -1,5 +1,6 @@
-//! MCAP stream: `/particles` (foxglove.PointCloud, protobuf) and `/diagnostics`
-//! (JSON with a JSON schema), zstd-compressed chunks, the resolved scenario as
+//! MCAP stream: `/particles` (foxglove.PointCloud, protobuf), `/diagnostics`
+//! and `/removed` (one message per particle leaving the domain; JSON with a JSON
+//! schema), zstd-compressed chunks, the resolved scenario as
 //! metadata. Every message closes its chunk and flushes, so a process killed hard
 //! leaves a file readable up to its last message; `finish` (or Drop) writes the
 //! summary and footer on every other ending.
@@ -16,6 +17,7 @@ use std::io::BufWriter;
 
 pub const PARTICLES_TOPIC: &str = "/particles";
 pub const DIAGNOSTICS_TOPIC: &str = "/diagnostics";
+pub const REMOVED_TOPIC: &str = "/removed";
 /// Name of the metadata record holding the run's provenance.
 pub const METADATA_NAME: &str = "spatter";
 
@@ -24,6 +26,10 @@ pub struct McapSink {
     writer: Option<Writer<BufWriter<File>>>,
     particles: u16,
     diagnostics: u16,
+    removed: u16,
+    /// Ids whose removal is written (None until the first state: a resumed run's
+    /// earlier removals are in the earlier file).
+    reported: Option<std::collections::HashSet<u32>>,
     sequence: u32,
     pub frames: u64,
     last_frame_step: Option<u32>,
@@ -65,12 +71,22 @@ impl McapSink {
                 diagnostics_schema(m).to_string().as_bytes(),
             )
             .map_err(|e| err(&e))?;
+        let removed_schema = w
+            .add_schema(
+                "spatter.Removal",
+                "jsonschema",
+                removal_schema().to_string().as_bytes(),
+            )
+            .map_err(|e| err(&e))?;
         let none = BTreeMap::new();
         let particles = w
             .add_channel(pc_schema, PARTICLES_TOPIC, "protobuf", &none)
             .map_err(|e| err(&e))?;
         let diagnostics = w
             .add_channel(diag_schema, DIAGNOSTICS_TOPIC, "json", &none)
+            .map_err(|e| err(&e))?;
+        let removed = w
+            .add_channel(removed_schema, REMOVED_TOPIC, "json", &none)
             .map_err(|e| err(&e))?;
         let meta = BTreeMap::from([
             (
@@ -93,6 +109,8 @@ impl McapSink {
             writer: Some(w),
             particles,
             diagnostics,
+            removed,
+            reported: None,
             sequence: 0,
             frames: 0,
             last_frame_step: None,
@@ -135,6 +153,20 @@ impl McapSink {
         self.write(self.diagnostics, d.time, &json)
     }
 
+    /// One `/removed` message per particle that has left since the last state
+    /// seen, logged at the time it left.
+    pub fn removals(&mut self, m: &Model, st: &State) -> Result<(), String> {
+        let Some(reported) = self.reported.as_mut() else {
+            self.reported = Some(crate::outflow::removed_ids(st));
+            return Ok(());
+        };
+        for e in crate::outflow::new_removals(m, st, reported) {
+            let json = serde_json::to_vec(&e).map_err(|e| e.to_string())?;
+            self.write(self.removed, e.time, &json)?;
+        }
+        Ok(())
+    }
+
     /// Write the summary and footer. Safe to call more than once.
     pub fn finish(&mut self) -> Result<(), String> {
         if let Some(mut w) = self.writer.take() {
@@ -143,6 +175,28 @@ impl McapSink {
         }
         Ok(())
     }
+}
+
+/// JSON schema of a `/removed` message (crate::outflow::RemovalEvent).
+fn removal_schema() -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Removal",
+        "type": "object",
+        "properties": {
+            "id": {"type": "integer", "description": "particle id"},
+            "phase": {"type": "string", "description": "its phase"},
+            "time": num("when it left, s"),
+            "side": {"type": "string", "description": "the side it left through (x_min ... z_max)"},
+            "x": num("where it was at the end of that step, m"),
+            "y": num("m"),
+            "z": num("m"),
+            "speed": num("its speed then, m/s"),
+            "mass": num("kg (per metre of depth in 2D)")
+        },
+        "required": ["id", "phase", "time", "side", "x", "y", "z", "speed", "mass"]
+    })
 }
 
 impl Drop for McapSink {

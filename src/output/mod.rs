@@ -61,14 +61,26 @@ pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
 /// pressure (Pa), mass (kg), phase (index into the scene's phases), id (the
 /// particle's index at setup, stable across reordering), and in heat scenes
 /// temperature (K), liquid fraction and specific enthalpy (J/kg).
+///
+/// Frames hold the particles still in the simulation only: the removed ones (the
+/// last `sim.removed` of the state, issue 18) are left out, so they do not hang
+/// frozen where they left in every later frame; `/removed` records them.
 pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
     let held = crate::fields::Held::of_state(st);
-    crate::fields::FIELDS
+    let active = st.active();
+    let mut fields: Vec<Field> = crate::fields::FIELDS
         .iter()
         .filter(|f| held.holds(f.holder))
         .filter_map(|f| f.frames)
         .flat_map(|channels| channels(m, st))
-        .collect()
+        .collect();
+    for f in &mut fields {
+        match &mut f.values {
+            Values::F32(v) => v.truncate(active),
+            Values::U32(v) => v.truncate(active),
+        }
+    }
+    fields
 }
 
 /// One channel.
@@ -154,8 +166,9 @@ pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     ]
 }
 
-/// One `/diagnostics` record. Fluid particles only: wall particles carry
-/// extrapolated velocities and pressures, not a state of their own.
+/// One `/diagnostics` record. Fluid particles in the domain only: wall particles
+/// carry extrapolated velocities and pressures, not a state of their own, and the
+/// removed ones are counted apart (`removed`, `removed_mass`).
 #[derive(Debug, Clone, Serialize)]
 pub struct Diagnostics {
     pub time: f64,
@@ -169,7 +182,12 @@ pub struct Diagnostics {
     pub max_speed: f64,
     pub min_density: f64,
     pub max_density: f64,
+    /// Particles in the domain per phase.
     pub particles: std::collections::BTreeMap<String, u64>,
+    /// Particles that have left the domain per phase, and their mass (kg; per
+    /// metre of depth in 2D) (issue 18).
+    pub removed: std::collections::BTreeMap<String, u64>,
+    pub removed_mass: std::collections::BTreeMap<String, f64>,
     /// Deepest fluid penetration behind a wall face, in Δx (issue 18).
     pub wall_penetration_max_dx: f64,
     /// Fluid particles more than ½Δx behind a wall face.
@@ -209,7 +227,7 @@ pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
     let (mut evap, mut rad) = (0.0, 0.0);
     let ta4 = m.ambient_temperature.powi(4);
     const SIGMA: f64 = 5.670374419e-8;
-    for i in 0..st.len() {
+    for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
         let Some(th) = ph.thermal.filter(|_| ph.conducts()) else {
             continue;
@@ -247,7 +265,7 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
     (d.evaporated_power, d.radiated_power) = surface_loss_power(m, st);
     let mut top = f64::NEG_INFINITY;
     let mut pool = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
-    for i in 0..st.len() {
+    for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
         if !ph.conducts() {
             continue;
@@ -288,13 +306,19 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         min_density: f64::INFINITY,
         max_density: f64::NEG_INFINITY,
         particles: m.phases.iter().map(|p| (p.name.clone(), 0)).collect(),
+        removed: m.phases.iter().map(|p| (p.name.clone(), 0)).collect(),
+        removed_mass: m.phases.iter().map(|p| (p.name.clone(), 0.0)).collect(),
         wall_penetration_max_dx: 0.0,
         wall_penetration_count: 0,
         heat: heat_diagnostics(m, st),
     };
     let leak = crate::watchdog::leakage(m, st);
     (d.wall_penetration_max_dx, d.wall_penetration_count) = (leak.deepest_dx, leak.beyond_half_dx);
-    for i in 0..st.len() {
+    for (phase, (n, mass)) in crate::outflow::Outflow::of(m, st).per_phase {
+        d.removed.insert(phase.clone(), n);
+        d.removed_mass.insert(phase, mass);
+    }
+    for i in 0..st.active() {
         let phase = &m.phases[st.phase[i] as usize];
         *d.particles.entry(phase.name.clone()).or_default() += 1;
         if !phase.is_fluid() {
@@ -328,6 +352,11 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         .iter()
         .map(|p| (p.name.clone(), serde_json::json!({"type": "integer"})))
         .collect();
+    let phase_masses: serde_json::Map<String, serde_json::Value> = m
+        .phases
+        .iter()
+        .map(|p| (p.name.clone(), serde_json::json!({"type": "number"})))
+        .collect();
     let mut schema = serde_json::json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "spatter.Diagnostics",
@@ -344,13 +373,18 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             "min_density": num("smallest fluid density, kg/m^3"),
             "max_density": num("largest fluid density, kg/m^3"),
             "particles": {"type": "object", "properties": phases,
-                          "description": "particle count per phase"},
+                          "description": "particles in the domain per phase"},
+            "removed": {"type": "object", "properties": phases,
+                        "description": "particles that have left the domain per phase"},
+            "removed_mass": {"type": "object", "properties": phase_masses,
+                             "description": format!("mass of the particles that have left the domain per phase, kg{per_depth}")},
             "wall_penetration_max_dx": num("deepest fluid penetration behind a wall face, dx"),
             "wall_penetration_count": {"type": "integer",
                                        "description": "fluid particles more than 0.5 dx behind a wall face"}
         },
         "required": ["time", "step", "dt", "dt_limit", "kinetic_energy", "total_mass",
                      "max_speed", "min_density", "max_density", "particles",
+                     "removed", "removed_mass",
                      "wall_penetration_max_dx", "wall_penetration_count"]
     });
     if m.is_thermal() {

@@ -10,12 +10,12 @@ use rayon::prelude::*;
 
 /// Also records each fluid particle's neighbours in `list` for the forces pass.
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
+    let n = st.active();
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
-    let chunks = list.take_chunks(st.len().div_ceil(LIST_CHUNK));
-    let chunks: Vec<ListChunk> = st
-        .rho
+    let chunks = list.take_chunks(n.div_ceil(LIST_CHUNK));
+    let chunks: Vec<ListChunk> = st.rho[..n]
         .par_chunks_mut(LIST_CHUNK)
-        .zip(st.press.par_chunks_mut(LIST_CHUNK))
+        .zip(st.press[..n].par_chunks_mut(LIST_CHUNK))
         .zip(chunks)
         .enumerate()
         .map(|(c, ((rho, p), mut chunk))| {

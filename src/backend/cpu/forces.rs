@@ -53,6 +53,7 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool>(
     grid: &CellTable,
     list: &NeighborList,
 ) {
+    let n = st.active();
     let (pos, vel, rho, p, mass, phase) =
         (&st.pos, &st.vel, &st.rho, &st.press, &st.mass, &st.phase);
     let surface = &st.surface;
@@ -60,9 +61,9 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool>(
     // compute per pair from the same operands: the same bits, fewer divisions.
     let eta_pair = PairViscosity::new(pr);
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
-    st.acc
+    st.acc[..n]
         .par_iter_mut()
-        .zip(st.acc_b.par_iter_mut())
+        .zip(st.acc_b[..n].par_iter_mut())
         .enumerate()
         .for_each(|(i, (acc, acc_b))| {
             let ph_i = phase[i];

@@ -40,7 +40,7 @@ fn heat_density(pr: &Params, rho: &[f32], phase: u32, i: usize) -> f32 {
 
 pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
     let (pos, phase, heat_in) = (&st.pos, &st.phase, &st.heat);
-    let out: Vec<Option<f32>> = (0..st.len())
+    let out: Vec<Option<f32>> = (0..st.active())
         .into_par_iter()
         .map(|i| {
             let ph = phase[i];
@@ -82,7 +82,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     let acc = &st.acc;
     let surf = &st.surface;
     let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
-    let rates: Vec<f32> = (0..st.len())
+    let rates: Vec<f32> = (0..st.active())
         .into_par_iter()
         .map(|i| {
             let ph_i = phase[i];
@@ -124,7 +124,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
             source - loss + sum / heat_density(pr, rho, ph_i, i)
         })
         .collect();
-    st.heat
+    st.heat[..rates.len()]
         .par_iter_mut()
         .zip(rates)
         .enumerate()
@@ -195,6 +195,7 @@ pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
 /// liquid whose liquid fraction falls below ½ becomes its solid phase, frozen in
 /// place (velocity and accelerations zeroed).
 pub fn temperature(pr: &Params, st: &mut State) {
+    let n = st.active();
     let State {
         heat,
         phase,
@@ -203,11 +204,13 @@ pub fn temperature(pr: &Params, st: &mut State) {
         acc_b,
         ..
     } = st;
-    heat.par_iter_mut()
-        .zip(phase.par_iter_mut())
+    heat[..n]
+        .par_iter_mut()
+        .zip(phase[..n].par_iter_mut())
         .zip(
-            vel.par_iter_mut()
-                .zip(acc.par_iter_mut().zip(acc_b.par_iter_mut())),
+            vel[..n]
+                .par_iter_mut()
+                .zip(acc[..n].par_iter_mut().zip(acc_b[..n].par_iter_mut())),
         )
         .for_each(|((hv, ph), (v, (a, ab)))| {
             if !pr.conducts(*ph) {

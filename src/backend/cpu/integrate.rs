@@ -13,10 +13,12 @@ use rayon::prelude::*;
 pub fn kick_drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
     let hdt = 0.5 * dt;
+    let left_at = st.sim.time + dt;
+    let n = st.active();
     let (acc, acc_b, phase) = (&st.acc, &st.acc_b, &st.phase);
-    st.pos
+    st.pos[..n]
         .par_iter_mut()
-        .zip(st.vel.par_iter_mut())
+        .zip(st.vel[..n].par_iter_mut())
         .enumerate()
         .for_each(|(i, (x, v))| {
             let ph = phase[i];
@@ -37,7 +39,18 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
                 x[c] += dt * (v[c] + hdt * ab[c]);
                 wrap_periodic(pr, x, c);
             }
+            stamp_if_left(pr, x, left_at);
         });
+}
+
+/// A fluid particle that has just left the keep box carries the time it left in
+/// w; the neighbour pass then sorts it last and the passes stop before it (issue
+/// 18). Walls are never removed.
+#[inline(always)]
+fn stamp_if_left(pr: &Params, x: &mut [f32; 4], left_at: f32) {
+    if pr.outside_keep_box(x) {
+        x[3] = left_at;
+    }
 }
 
 /// Brings coordinate `c` back into [0, period) on a periodic axis.
@@ -58,8 +71,9 @@ fn wrap_periodic(pr: &Params, x: &mut [f32; 4], c: usize) {
 pub fn kick(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
     let hdt = 0.5 * dt;
+    let n = st.active();
     let (acc, phase, heat) = (&st.acc, &st.phase, &st.heat);
-    st.vel.par_iter_mut().enumerate().for_each(|(i, v)| {
+    st.vel[..n].par_iter_mut().enumerate().for_each(|(i, v)| {
         if pr.is_wall(phase[i]) {
             return;
         }

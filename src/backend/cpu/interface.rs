@@ -34,10 +34,11 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     if pr.flag(FLAG_GAS_INTERFACE) {
         return gas_interface(pr, st, grid);
     }
-    let n = st.len();
+    // Sums of the particles still in the simulation; the Shepard sums follow all n.
+    let (n, active) = (st.len(), st.active());
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
-    let gamma: Vec<f32> = (0..n)
+    let gamma: Vec<f32> = (0..active)
         .into_par_iter()
         .map(|i| {
             if !condensed(pr, phase[i]) {
@@ -53,7 +54,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
         })
         .collect();
     let inv_h = pr.kernel.inv_h;
-    let normals: Vec<[f32; 4]> = (0..n)
+    let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
         .map(|i| {
             if !condensed(pr, phase[i]) || !pr.conducts(phase[i]) {
@@ -79,8 +80,8 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             }
         })
         .collect();
-    st.surface[..n].copy_from_slice(&normals);
-    for (s, g) in st.surface[n..].iter_mut().zip(gamma) {
+    st.surface[..active].copy_from_slice(&normals);
+    for (s, g) in st.surface[n..n + active].iter_mut().zip(gamma) {
         *s = [g, 0.0, 0.0, 0.0];
     }
 }
@@ -98,7 +99,7 @@ fn density(pr: &Params, st: &State, j: usize) -> f32 {
 
 /// F22 (19)–(20) between condensed particles and gas particles.
 fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
-    let n = st.len();
+    let n = st.active();
     let inv_h = pr.kernel.inv_h;
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let s: &State = st;

@@ -129,9 +129,10 @@ fn irradiance(pr: &Params, p: &[f32; 4], centre: [f32; 2], power: f32) -> f32 {
 }
 
 /// Store each conducting particle's laser source q (W/kg) in heat.w.
+/// The source of the first q.len() particles (the ones still in the simulation).
 fn write_source(pr: &Params, st: &mut State, q: &[f32]) {
     let phase = &st.phase;
-    for (i, hv) in st.heat.iter_mut().enumerate() {
+    for (i, hv) in st.heat[..q.len()].iter_mut().enumerate() {
         if pr.conducts(phase[i]) {
             hv[3] = q[i];
         }
@@ -186,7 +187,7 @@ pub fn deposit(pr: &Params, st: &mut State, bins: &[[f32; 2]]) {
     let nb = pr.laser.bins;
     let dim = pr.sizes.dim as usize;
     let dx = pr.laser.bin_size;
-    let q: Vec<f32> = (0..st.len())
+    let q: Vec<f32> = (0..st.active())
         .into_par_iter()
         .map(|i| {
             if !absorbs(pr, phase[i]) {
@@ -239,7 +240,7 @@ fn bin_at(pr: &Params, k: [i32; 3]) -> Option<[u32; 3]> {
 }
 
 pub fn surface(pr: &Params, st: &mut State) {
-    let n = st.len();
+    let n = st.active();
     let up = pr.sizes.dim as usize - 1;
     let centre = beam_centre(pr, st.sim.time);
     let power = beam_power(pr, st.sim.time);

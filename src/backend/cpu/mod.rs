@@ -51,7 +51,7 @@ impl CpuBackend {
     pub fn pair_count(&self) -> u64 {
         use rayon::prelude::*;
         let (pr, st, grid) = (&self.params, &self.st, &self.grid);
-        (0..st.len())
+        (0..st.active())
             .into_par_iter()
             .filter(|&i| !pr.is_wall(st.phase[i]))
             .map(|i| {

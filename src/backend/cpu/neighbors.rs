@@ -1,5 +1,6 @@
 //! Twin of shaders/neighbors.wgsl: cell keys, the (cell, index) sort, reordering of
-//! every particle array by cell, and the cell start/end table.
+//! every particle array by cell, the cell start/end table and the count of
+//! particles that have left (sorted last, in no cell).
 //! Keys are unique, so any correct sort gives the one order the GPU's bitonic sort gives.
 
 use crate::fields::{Held, FIELDS};
@@ -419,13 +420,25 @@ fn wrap(c: i32, n: u32, periodic: bool) -> Option<u32> {
     }
 }
 
+/// The cell a particle sorts into; n_cells, after every cell and in none, for a
+/// fluid particle that has left the domain (issue 18). Walls stay, wherever they
+/// stand (those of a closed side reach past the open face above it).
+#[inline(always)]
+fn cell_key(pr: &Params, p: &[f32; 4], phase: u32) -> u32 {
+    if !pr.is_wall(phase) && pr.outside_keep_box(p) {
+        pr.sizes.n_cells
+    } else {
+        cell_index(pr, cell_coord(pr, p))
+    }
+}
+
 pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     let n = st.len();
     let mut keys: Vec<(u32, u32)> = st
         .pos
         .par_iter()
         .enumerate()
-        .map(|(i, p)| (cell_index(pr, cell_coord(pr, p)), i as u32))
+        .map(|(i, p)| (cell_key(pr, p, st.phase[i]), i as u32))
         .collect();
     keys.par_sort_unstable();
     let perm: Vec<usize> = keys.iter().map(|k| k.1 as usize).collect();
@@ -446,7 +459,9 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     grid.end.resize(n_cells, 0);
     grid.fluid.clear();
     grid.fluid.resize(n_cells, false);
-    for k in 0..n {
+    let gone = pr.sizes.n_cells;
+    st.sim.removed = keys.iter().rev().take_while(|k| k.0 == gone).count() as u32;
+    for k in 0..n - st.sim.removed as usize {
         let c = keys[k].0;
         if k == 0 || keys[k - 1].0 != c {
             grid.start[c as usize] = k as u32;

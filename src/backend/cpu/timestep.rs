@@ -8,7 +8,7 @@ use crate::state::State;
 use rayon::prelude::*;
 
 pub fn run(pr: &Params, st: &mut State) {
-    let (umax2, amax2) = (0..st.len())
+    let (umax2, amax2) = (0..st.active())
         .into_par_iter()
         .filter(|&i| !pr.is_wall(st.phase[i]))
         .map(|i| {

@@ -26,7 +26,7 @@ use crate::state::State;
 use rayon::prelude::*;
 
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
-    let n = st.len();
+    let n = st.active();
     let (pos, phase) = (&st.pos, &st.phase);
     let (rho_in, p_in, vel_in) = (&st.rho, &st.press, &st.vel);
     let out: Vec<Option<(f32, f32, [f32; 4])>> = (0..n)

@@ -1,7 +1,8 @@
 // uses: params bindings consts kernel grid phase
 // writes: acc acc_b
 // Pressure + viscous forces F22 (23), transport-velocity background pressure
-// (Adami 2013), interface viscosity F22 (31), viscous heating and gravity: one
+// (Adami 2013), interface viscosity F22 (31), viscous heating, the wall barrier
+// F22 (34) and gravity: one
 // sweep over the neighbours, each pair term a function in shaders/terms/ (the
 // host appends the pass's terms; a switchable term is removed at pipeline
 // creation by its override constant). Twin of src/backend/cpu/forces.rs, which
@@ -84,6 +85,12 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                     share = c_one();
                 }
                 heating = heating - viscous_heating(v_i, v_j, w, share, vv, fv);
+            }
+            if (TERM_BARRIER && wall && r < P.flow.barrier_radius) {
+                let s = barrier(v_i, P.phases[ph_j].velocity, d, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] + s * d[a];
+                }
             }
         }
     }

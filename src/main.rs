@@ -522,8 +522,14 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             "none (not in this scene)".to_string()
         }
     };
+    // The barrier's limit only where the scene has one.
+    let barrier = if l.barrier.is_finite() {
+        format!(", barrier {}", limit(l.barrier))
+    } else {
+        String::new()
+    };
     println!(
-        "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}; binding: {which}",
+        "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}{barrier}; binding: {which}",
         limit(l.acoustic),
         limit(l.viscous),
         limit(l.body_force),

@@ -109,6 +109,11 @@ gpu_struct! {
         pub conduction_limit: f32,
         /// A fixed Δt (0: adaptive).
         pub fixed_dt: f32,
+        /// 0.22 √(m/k_b), the barrier force's limit.
+        pub barrier_limit: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
     }
 }
 
@@ -123,7 +128,12 @@ gpu_struct! {
         pub interface_viscosity: f32,
         /// Wall pass: Shepard weight floor ε (`WALL_WEIGHT_FLOOR` × W(0)).
         pub wall_weight_floor: f32,
+        /// F22 (34) barrier between fluid and walls: r_b (m; 0 = off), k_b, d_b.
+        pub barrier_radius: f32,
+        pub barrier_stiffness: f32,
+        pub barrier_damping: f32,
         pub pad0: f32,
+        pub pad1: f32,
     }
 }
 
@@ -393,6 +403,10 @@ impl Params {
             viscous_limit: finite_or_max(m.limits.viscous),
             conduction_limit: finite_or_max(m.limits.conduction),
             fixed_dt: m.fixed_dt.unwrap_or(0.0) as f32,
+            barrier_limit: finite_or_max(m.limits.barrier),
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
         };
         p.flow = Flow {
             gravity: [
@@ -404,7 +418,11 @@ impl Params {
             background_pressure: m.background_pressure as f32,
             interface_viscosity: 0.0,
             wall_weight_floor: 0.0,
+            barrier_radius: m.barrier.map_or(0.0, |b| b.radius as f32),
+            barrier_stiffness: m.barrier.map_or(0.0, |b| b.stiffness as f32),
+            barrier_damping: m.barrier.map_or(0.0, |b| b.damping as f32),
             pad0: 0.0,
+            pad1: 0.0,
         };
         for (i, ph) in m.phases.iter().enumerate() {
             p.phases[i] = phase_block(ph);

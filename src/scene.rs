@@ -169,6 +169,25 @@ pub struct Simulation {
     /// Temperature of the surroundings for radiation loss (K).
     #[serde(default = "default_ambient")]
     pub ambient_temperature: f64,
+    /// F22 (34) barrier force between fluid and wall particles closer than its
+    /// radius: keeps splashes out of the walls. Absent: off.
+    pub barrier: Option<BarrierDef>,
+}
+
+/// `simulation.barrier`: F22 (34) F = Σ_j (k_b g + d_b g ġ) e_ij over wall
+/// particles j with r_ij < r_b, g = r_b − r_ij, ġ = −e_ij·u_ij.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BarrierDef {
+    /// r_b (m), below h (F22: 0.83 µm ≈ Δx/2); or `radius_dx`, in Δx, which
+    /// follows a `--set dx=…` refinement.
+    pub radius: Option<f64>,
+    pub radius_dx: Option<f64>,
+    /// k_b (kg/s², N/m; F22: 1.0).
+    pub stiffness: f64,
+    /// d_b (kg/(m s); F22: 1.0).
+    #[serde(default)]
+    pub damping: f64,
 }
 
 fn default_ambient() -> f64 {

@@ -21,7 +21,14 @@ pub struct Sim {
     pub _pad: u32,
 }
 
-pub const DT_LIMIT_NAMES: [&str; 5] = ["acoustic", "viscous", "force", "fixed", "conduction"];
+pub const DT_LIMIT_NAMES: [&str; 6] = [
+    "acoustic",
+    "viscous",
+    "force",
+    "fixed",
+    "conduction",
+    "barrier",
+];
 
 /// Name of the limit code the timestep pass wrote.
 pub fn dt_limit_name(code: u32) -> &'static str {

@@ -10,8 +10,14 @@ use spatter::run::load;
 
 /// Returns the particles removed by the end (issue 18).
 fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) -> u32 {
+    assert_bit_identical_at(&common::scene(name), sets, steps).removed
+}
+
+/// The same for a scene file anywhere; returns the CPU's final Sim.
+fn assert_bit_identical_at(path: &str, sets: &[&str], steps: u64) -> spatter::state::Sim {
+    let name = path;
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let l = load(&common::scene(name), &sets).unwrap();
+    let l = load(path, &sets).unwrap();
     let params = Params::new(&l.model, l.state.len() as u32);
     std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
@@ -34,7 +40,7 @@ fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) -> u32 {
         report.stages_compared,
         (stages.prime.len() + stages.step.len() * steps as usize) as u64
     );
-    cpu.st.sim.removed
+    cpu.st.sim
 }
 
 #[test]
@@ -48,6 +54,34 @@ fn dam_break_2d_200_steps() {
 fn jet_outflow_2d_with_removals_200_steps() {
     let removed = assert_bit_identical("jet_outflow_2d", &[], 200);
     assert!(removed >= 16, "{removed} particles left in 200 steps");
+}
+
+/// The F22 (34) wall barrier: the jet of jet_outflow_2d moved down to the floor
+/// and thrown at it at 6 m/s, so that particles come within r_b of the wall
+/// particles from step 60 on (the barrier changes the state: checked against the
+/// same run without it).
+#[test]
+fn wall_barrier_on_a_jet_into_the_floor_200_steps() {
+    let text = std::fs::read_to_string(common::scene("jet_outflow_2d"))
+        .unwrap()
+        .replace(
+            "min = [0.15, 0.08], max = [0.29, 0.12]",
+            "min = [0.15, 0.02], max = [0.29, 0.06]",
+        )
+        .replace("velocity = [1.5, 0.0]", "velocity = [1.5, -6.0]");
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_barrier");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("jet_into_floor.toml");
+    std::fs::write(&path, text).unwrap();
+    let path = path.to_str().unwrap();
+    let barrier = "simulation.barrier={radius_dx=0.75, stiffness=1.0e5, damping=2.0e4}";
+    let with = assert_bit_identical_at(path, &[barrier], 200);
+    let l = load(path, &[]).unwrap();
+    let mut plain = CpuBackend::new(Params::new(&l.model, l.state.len() as u32), l.state.clone());
+    use spatter::backend::Backend;
+    plain.prime();
+    plain.run_steps(200);
+    assert_ne!(with, plain.st.sim, "the barrier acted (Δt follows |a|max)");
 }
 
 #[test]

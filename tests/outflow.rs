@@ -1,5 +1,6 @@
 //! Issue 18: particles that leave through an open side are taken out, counted and
 //! recorded, with the mass balance exact; the "stop" policy ends the run instead.
+//! Walls hold splashes with the F22 (34) barrier.
 
 mod common;
 use common::{reader, scratch, spatter, text};
@@ -213,4 +214,92 @@ fn resume_across_removals_is_bit_identical_on_cpu() {
 #[test]
 fn resume_across_removals_is_bit_identical_on_the_software_adapter() {
     resume_across_removals("gpu");
+}
+
+/// The issue's own check: the 3D dam break run on to t = 1 s (the scene ends at
+/// 0.18 s) completes. Splashes leave through the open top (54 of 15 296 particles,
+/// all through z_max) and the mass balance is exact; the wall barrier keeps the
+/// sloshing out of the walls (deepest penetration 0.51 Δx; without it a particle
+/// went through all three layers of the y_max wall at t = 0.92 s). The exit code
+/// is the surge-front check's: it samples T ≤ 2.5 whatever the end, and the front
+/// runs 16% ahead of Koshizuka & Oka at this Δx (the known gap of the 2D
+/// `dam_break_front_within_10_percent`, ignored with its reason), so exit 1 and
+/// that FAIL line, never the watchdog's 3.
+#[test]
+fn dam_break_3d_runs_on_to_one_second() {
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_3d"),
+        "--backend",
+        "cpu",
+        "--until",
+        "1.0",
+    ]);
+    let (stdout, stderr) = text(&out);
+    let check_fails = stdout
+        .lines()
+        .any(|l| l.starts_with("check dam_break_front:") && l.ends_with("FAIL"));
+    let expected = if check_fails { 1 } else { 0 };
+    assert_eq!(out.status.code(), Some(expected), "{stdout}{stderr}");
+    assert!(!stderr.contains("unstable"), "{stderr}");
+    assert!(stdout.contains("simulated time: 1.0000"), "{stdout}");
+    let line = |start: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no `{start}` line: {stdout}"))
+            .to_string()
+    };
+    let outflow = line("outflow: ");
+    assert!(
+        outflow.contains("particle(s) left the domain: water") && outflow.contains("through z_max"),
+        "{outflow}"
+    );
+    assert!(line("mass: ").contains("equal to the initial mass exactly"));
+    let leak = line("wall leakage: deepest fluid penetration ");
+    let depth: f64 = leak
+        .trim_start_matches("wall leakage: deepest fluid penetration ")
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    // Measured 0.51 Δx; one wall layer sits at 0.5 Δx, and the run stops at 3.
+    assert!(depth < 1.0, "{leak}");
+}
+
+/// simulation.barrier: one radius, in metres or in Δx, below h.
+#[test]
+fn barrier_input_is_checked() {
+    let scene = common::scene("dam_break_3d");
+    for (set, key) in [
+        (
+            "simulation.barrier={radius_dx=1.0, stiffness=1.0}",
+            "simulation.barrier.radius_dx",
+        ),
+        (
+            "simulation.barrier={radius=0.005, radius_dx=0.5, stiffness=1.0}",
+            "simulation.barrier",
+        ),
+        (
+            "simulation.barrier={radius=0.005, stiffness=0.0}",
+            "simulation.barrier.stiffness",
+        ),
+        (
+            "simulation.barrier={radius=0.005, stiffness=1.0, damping=-1.0}",
+            "simulation.barrier.damping",
+        ),
+        (
+            "simulation.barrier={radius=0.005, stiffness=1.0, spring=1.0}",
+            "spring",
+        ),
+    ] {
+        let out = spatter(&["validate", &scene, "--set", set]);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{set}: {stderr}");
+        assert!(stderr.contains(key), "{set}: {stderr}");
+    }
+    let ok = spatter(&["validate", &scene]);
+    let (stdout, _) = text(&ok);
+    assert!(stdout.contains("barrier 1.5556e-4 s"), "{stdout}");
 }

@@ -173,8 +173,8 @@ fn dam_break_front_within_10_percent() {
 /// speed fails whatever the delay (unit test in checks/dam_break.rs); the unshifted criterion
 /// stays in the ignored test above. Measured on the CPU (2D, dx = 2.5 mm): K&O
 /// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
-/// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse): 7.5% at
-/// ΔT = 0.152, 2.4% at ΔT = 0.185.
+/// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse, with its
+/// wall barrier): 7.5% at ΔT = 0.150, 2.5% at ΔT = 0.185.
 fn front_matches_after_release_delay(scene: &str) {
     let c = run_check(scene, &[]);
     let figure = |key: String| {

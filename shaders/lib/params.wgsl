@@ -35,6 +35,10 @@ struct TimeStep {
     viscous_limit: f32,      // 0.125 h²/nu
     conduction_limit: f32,   // 0.1 rho c_p h²/k
     fixed_dt: f32,           // 0: adaptive
+    barrier_limit: f32,      // 0.22 sqrt(m/k_b)
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 struct Flow {
@@ -42,7 +46,11 @@ struct Flow {
     background_pressure: f32,
     interface_viscosity: f32, // F22 (32) alpha_0^lg (0 = off)
     wall_weight_floor: f32,   // wall pass: Shepard weight floor
+    barrier_radius: f32,      // F22 (34) r_b (0 = off)
+    barrier_stiffness: f32,   // k_b
+    barrier_damping: f32,     // d_b
     pad0: f32,
+    pad1: f32,
 }
 
 struct Surfaces {

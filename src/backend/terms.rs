@@ -21,7 +21,7 @@ pub struct PairTerm {
     pub active: fn(&Params) -> bool,
 }
 
-pub const PAIR_TERMS: [PairTerm; 5] = [
+pub const PAIR_TERMS: [PairTerm; 6] = [
     PairTerm {
         name: "pressure",
         pass: "forces",
@@ -56,6 +56,13 @@ pub const PAIR_TERMS: [PairTerm; 5] = [
         wgsl: include_str!("../../shaders/terms/viscous_heating.wgsl"),
         switch: Some("TERM_VISCOUS_HEATING"),
         active: |p| p.flag(FLAG_VISCOUS_HEATING),
+    },
+    PairTerm {
+        name: "barrier",
+        pass: "forces",
+        wgsl: include_str!("../../shaders/terms/barrier.wgsl"),
+        switch: Some("TERM_BARRIER"),
+        active: |p| p.flow.barrier_radius > 0.0,
     },
 ];
 

@@ -37,6 +37,8 @@ pub struct DtLimits {
     pub body_force: f64,
     /// 0.1 ρ c_p h²/k over conducting phases (issue 4); ∞ without heat.
     pub conduction: f64,
+    /// F22 (42) 0.22 √(m/k_b) with the lightest fluid particle; ∞ without barrier.
+    pub barrier: f64,
 }
 
 impl DtLimits {
@@ -50,6 +52,9 @@ impl DtLimits {
         }
         if self.conduction < best.0 {
             best = (self.conduction, "conduction 0.1 rho c_p h^2/k");
+        }
+        if self.barrier < best.0 {
+            best = (self.barrier, "barrier 0.22 sqrt(m/k_b)");
         }
         best
     }
@@ -100,6 +105,8 @@ pub struct Model {
     pub check: Option<CheckDef>,
     pub watchdog: WatchdogDef,
     pub laser: Option<Laser>,
+    /// F22 (34) barrier between fluid and walls.
+    pub barrier: Option<Barrier>,
     pub limits: DtLimits,
 }
 
@@ -304,6 +311,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .map(|p| p.viscosity / p.rho0)
         .fold(interface_viscosity_nu(&cx, sim, &fluid, dim, h)?, f64::max);
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
+    let barrier = barrier_def(&cx, sim, h, dx)?;
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
             0.25 * h / c_max
@@ -321,6 +329,13 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             f64::INFINITY
         },
         conduction,
+        barrier: match &barrier {
+            Some(b) => {
+                let m_min = fluid.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
+                0.22 * (m_min / b.stiffness).sqrt()
+            }
+            None => f64::INFINITY,
+        },
     };
 
     let run = &scene.run;
@@ -421,6 +436,56 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         check: scene.check.clone(),
         watchdog: scene.watchdog.clone(),
         laser,
+        barrier,
         limits,
     })
+}
+
+/// F22 (34) barrier: radius r_b (m), stiffness k_b (kg/s²), damping d_b (kg/(m s)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Barrier {
+    pub radius: f64,
+    pub stiffness: f64,
+    pub damping: f64,
+}
+
+/// `simulation.barrier`: 0 < r_b < h (F22 §3.3.6), k_b > 0, d_b ≥ 0.
+fn barrier_def(
+    cx: &Ctx,
+    sim: &crate::scene::Simulation,
+    h: f64,
+    dx: f64,
+) -> Result<Option<Barrier>, InputError> {
+    let Some(b) = sim.barrier else {
+        return Ok(None);
+    };
+    let (key, radius) = match (b.radius, b.radius_dx) {
+        (Some(r), None) => (
+            "simulation.barrier.radius",
+            cx.positive("simulation.barrier.radius", r)?,
+        ),
+        (None, Some(k)) => (
+            "simulation.barrier.radius_dx",
+            cx.positive("simulation.barrier.radius_dx", k)? * dx,
+        ),
+        _ => {
+            return Err(cx.err(
+                "simulation.barrier",
+                "give radius (m) or radius_dx (in dx), one of them",
+            ))
+        }
+    };
+    if radius >= h {
+        return Err(cx.err(
+            key,
+            format!(
+                "r_b = {radius:e} m must be below the smoothing length h = {h:e} m (F22 §3.3.6)"
+            ),
+        ));
+    }
+    Ok(Some(Barrier {
+        radius,
+        stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
+        damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
+    }))
 }

@@ -9,7 +9,8 @@
 //! Each pair term is a function in cpu/terms/ (the twin of shaders/terms/), called
 //! in the order of backend::terms::PAIR_TERMS: pressure and viscosity (summed into
 //! one force, as F22 (23) writes them), background pressure (into acc_b), the
-//! interface viscosity F22 (31)–(32) and the viscous heating (into acc.w).
+//! interface viscosity F22 (31)–(32), the viscous heating (into acc.w) and the
+//! wall barrier F22 (34).
 
 use super::neighbors::{for_each_listed, CellTable, NeighborList};
 use super::terms;
@@ -41,13 +42,14 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     monomorphise!(sweep::<>(pr, st, grid, list); [
         active(pr, "background_pressure"),
         active(pr, "interface_viscosity"),
-        active(pr, "viscous_heating")
+        active(pr, "viscous_heating"),
+        active(pr, "barrier")
     ])
 }
 
-/// One fused neighbour sweep: BG, IV, VH switch the background pressure, the
-/// interface viscosity and the viscous heating.
-fn sweep<const BG: bool, const IV: bool, const VH: bool>(
+/// One fused neighbour sweep: BG, IV, VH, BR switch the background pressure, the
+/// interface viscosity, the viscous heating and the wall barrier.
+fn sweep<const BG: bool, const IV: bool, const VH: bool, const BR: bool>(
     pr: &Params,
     st: &mut State,
     grid: &CellTable,
@@ -132,6 +134,12 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool>(
                         (v_j, 0.5)
                     };
                     heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
+                }
+                if BR && wall && r < pr.flow.barrier_radius {
+                    let s = terms::barrier(pr, v_i, mat_j.velocity, d, r);
+                    for a in 0..3 {
+                        f[a] += s * d[a];
+                    }
                 }
             });
             let g = pr.flow.gravity;

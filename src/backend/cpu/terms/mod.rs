@@ -2,12 +2,14 @@
 //! file each, same name, arguments and operation order as the WGSL function.
 
 mod background_pressure;
+mod barrier;
 mod interface_viscosity;
 mod pressure;
 mod viscosity;
 mod viscous_heating;
 
 pub use background_pressure::background_pressure;
+pub use barrier::barrier;
 pub use interface_viscosity::{interface_viscosity, interface_viscosity_alpha};
 pub use pressure::pressure;
 pub use viscosity::{pair_viscosity, viscosity};

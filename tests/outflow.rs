@@ -303,3 +303,35 @@ fn barrier_input_is_checked() {
     let (stdout, _) = text(&ok);
     assert!(stdout.contains("barrier 1.5556e-4 s"), "{stdout}");
 }
+
+/// Removal does not hide an instability: a fixed Δt 200 times the acoustic limit
+/// (3.125e-5 s) blows dam_break_2d apart in its second step; particles flung
+/// through the walls are removed like any other leaving the box, and the
+/// watchdog names one of them as having passed through every wall layer.
+#[test]
+fn a_time_step_200_times_the_limit_still_stops_within_a_few_steps() {
+    let out = spatter(&[
+        "run",
+        &common::scene("dam_break_2d"),
+        "--backend",
+        "cpu",
+        "--set",
+        "dt=6.25e-3",
+        "--set",
+        "dt_check=false",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
+    let msg = stderr
+        .lines()
+        .find(|l| l.contains("unstable at step"))
+        .expect("diagnosis");
+    let step: u64 = msg
+        .split("unstable at step ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .expect("step number");
+    assert!(step <= 3, "{msg}");
+    assert!(msg.contains(": particle ") && msg.contains(", field "), "{msg}");
+}

@@ -522,12 +522,14 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             "none (not in this scene)".to_string()
         }
     };
-    // The barrier's limit only where the scene has one.
-    let barrier = if l.barrier.is_finite() {
-        format!(", barrier {}", limit(l.barrier))
-    } else {
-        String::new()
-    };
+    // The barrier's and the capillary limit only where the scene has them.
+    let mut barrier = String::new();
+    if l.barrier.is_finite() {
+        barrier.push_str(&format!(", barrier {}", limit(l.barrier)));
+    }
+    if l.capillary.is_finite() {
+        barrier.push_str(&format!(", capillary {}", limit(l.capillary)));
+    }
     println!(
         "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}{barrier}; binding: {which}",
         limit(l.acoustic),

@@ -27,6 +27,8 @@ pub const FLAG_INTERFACE: u32 = 64;
 /// F22's gas-interface form (19)–(20): the scene has gas particles beside the
 /// condensed phase, so no Shepard sums are needed.
 pub const FLAG_GAS_INTERFACE: u32 = 128;
+/// F22 (24)–(26) surface tension between `tension.liquid` and `tension.gas`.
+pub const FLAG_SURFACE_TENSION: u32 = 256;
 
 /// `Phase::kind`.
 pub const KIND_LIQUID: u32 = 0;
@@ -111,7 +113,8 @@ gpu_struct! {
         pub fixed_dt: f32,
         /// 0.22 √(m/k_b), the barrier force's limit.
         pub barrier_limit: f32,
-        pub pad0: f32,
+        /// 0.25 √(ρ h³/(2π α)), the capillary limit.
+        pub capillary_limit: f32,
         pub pad1: f32,
         pub pad2: f32,
     }
@@ -148,6 +151,27 @@ gpu_struct! {
         pub ambient_t4: f32,
         pub pad0: f32,
         pub pad1: f32,
+    }
+}
+
+gpu_struct! {
+    /// Surface tension F22 (24)–(26), (8), (21) between one liquid and one gas
+    /// phase (FLAG_SURFACE_TENSION).
+    pub struct Tension {
+        /// α0, α0', T_α0, α_min of F22 (8).
+        pub alpha0: f32,
+        pub alpha_slope: f32,
+        pub t_ref: f32,
+        pub alpha_min: f32,
+        /// F22 (21) ramp f[T, T_m, T_m + ΔT_s]: T_m and 1/ΔT_s (0: no ramp, f = 1).
+        pub t_melt: f32,
+        pub inv_ramp_width: f32,
+        pub liquid: u32,
+        pub gas: u32,
+        pub pad0: u32,
+        pub pad3: u32,
+        pub pad1: u32,
+        pub pad2: u32,
     }
 }
 
@@ -315,6 +339,7 @@ gpu_struct! {
         pub time_step: TimeStep,
         pub flow: Flow,
         pub surfaces: Surfaces,
+        pub tension: Tension,
         pub laser: Laser,
         pub phases: [Phase; MAX_PHASES],
         pub consts: Consts,
@@ -404,7 +429,7 @@ impl Params {
             conduction_limit: finite_or_max(m.limits.conduction),
             fixed_dt: m.fixed_dt.unwrap_or(0.0) as f32,
             barrier_limit: finite_or_max(m.limits.barrier),
-            pad0: 0.0,
+            capillary_limit: finite_or_max(m.limits.capillary),
             pad1: 0.0,
             pad2: 0.0,
         };
@@ -433,12 +458,13 @@ impl Params {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);
             // The condensed side of F22's interface: a conducting liquid or solid,
             // or (interface viscosity without heat) the liquid.
-            let condensed = m.phases.iter().find(|ph| {
+            let tension_liquid = m.surface_tension.as_ref().map(|s| s.liquid);
+            let condensed = m.phases.iter().enumerate().find(|(i, ph)| {
                 matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid)
-                    && (ph.conducts() || m.interface_viscosity > 0.0)
+                    && (ph.conducts() || m.interface_viscosity > 0.0 || tension_liquid == Some(*i))
             });
             let kappa = match (gas, condensed) {
-                (Some(g), Some(c)) => {
+                (Some(g), Some((_, c))) => {
                     p.sizes.flags |= FLAG_GAS_INTERFACE;
                     gas_delta_integral(&p, m.dx, c.rho0, g.rho0)
                 }
@@ -447,6 +473,20 @@ impl Params {
             p.surfaces.inv_kappa = (1.0 / kappa) as f32;
             p.surfaces.ambient_t4 = m.ambient_temperature.powi(4) as f32;
             p.flow.interface_viscosity = m.interface_viscosity as f32;
+        }
+        if let Some(s) = &m.surface_tension {
+            p.sizes.flags |= FLAG_SURFACE_TENSION;
+            let t = &mut p.tension;
+            t.alpha0 = s.coefficient as f32;
+            t.alpha_slope = s.slope as f32;
+            t.t_ref = s.reference_temperature as f32;
+            t.alpha_min = s.minimum as f32;
+            if let Some((t_m, width)) = s.ramp {
+                t.t_melt = t_m as f32;
+                t.inv_ramp_width = (1.0 / width) as f32;
+            }
+            t.liquid = s.liquid as u32;
+            t.gas = s.gas as u32;
         }
         p.flow.wall_weight_floor = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
         p
@@ -486,7 +526,9 @@ impl Params {
     /// Particles F22's gas-interface pass gives a normal and δ: conducting ones (for
     /// the surface fluxes) and, with the interface viscosity on, every fluid one.
     pub fn gets_gas_interface(&self, phase: u32) -> bool {
-        self.conducts(phase) || (self.flow.interface_viscosity > 0.0 && !self.is_wall(phase))
+        self.conducts(phase)
+            || ((self.flow.interface_viscosity > 0.0 || self.flag(FLAG_SURFACE_TENSION))
+                && !self.is_wall(phase))
     }
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phases[phase as usize].flags

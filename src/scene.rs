@@ -99,6 +99,32 @@ pub struct SceneFile {
     #[serde(default)]
     pub watchdog: WatchdogDef,
     pub laser: Option<LaserDef>,
+    pub surface_tension: Option<SurfaceTensionDef>,
+}
+
+/// `[surface_tension]`: CSF surface tension with Marangoni, F22 (24)–(26), (8),
+/// between one liquid phase and one gas phase (F22's form, with gas particles).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceTensionDef {
+    /// The liquid phase.
+    pub liquid: String,
+    /// The gas phase around it.
+    pub gas: String,
+    /// α0 (N/m): the coefficient at `reference_temperature` (or everywhere when
+    /// `temperature_coefficient` is 0).
+    pub coefficient: f64,
+    /// α0' (N/(m K)), F22 (8): α(T) = α0 + α0' (T − T_α0), ≤ 0. Default 0.
+    #[serde(default)]
+    pub temperature_coefficient: f64,
+    /// T_α0 (K); needed with a temperature coefficient.
+    pub reference_temperature: Option<f64>,
+    /// α_min (N/m): α is clipped there, and α' is 0 where it is. Default 0.
+    #[serde(default)]
+    pub minimum: f64,
+    /// ΔT_s (K), F22 (21): in heat scenes whose liquid melts, the force and each
+    /// curvature neighbour ramp from 0 at the solidus to 1 at solidus + ΔT_s.
+    pub melting_width: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -430,6 +456,9 @@ pub struct CheckDef {
     pub experiment: DamBreakExperiment,
     /// Hydrostatic: particles closer than this to the free surface are excluded (m).
     pub exclude_depth: Option<f64>,
+    /// Laplace: centre and radius of the drop (m).
+    pub center: Option<Vec<f64>>,
+    pub radius: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -469,6 +498,8 @@ pub enum CheckKind {
     /// Weak compressibility: the largest (ρ − ρ0)/ρ0 of any liquid particle at any
     /// sample, the cost side of a WCSPH sound speed (c ≥ 10 u_max aims at about 1%).
     Compression,
+    /// Pressure jump across a drop's surface against Laplace's σ/R (2D), 2σ/R (3D).
+    Laplace,
 }
 
 impl CheckKind {
@@ -487,6 +518,7 @@ impl CheckKind {
             CheckKind::LaserEnergy => "laser_energy",
             CheckKind::Rosenthal => "rosenthal",
             CheckKind::Compression => "compression",
+            CheckKind::Laplace => "laplace",
         }
     }
 }

@@ -21,13 +21,14 @@ pub struct Sim {
     pub _pad: u32,
 }
 
-pub const DT_LIMIT_NAMES: [&str; 6] = [
+pub const DT_LIMIT_NAMES: [&str; 7] = [
     "acoustic",
     "viscous",
     "force",
     "fixed",
     "conduction",
     "barrier",
+    "capillary",
 ];
 
 /// Name of the limit code the timestep pass wrote.

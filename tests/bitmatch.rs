@@ -251,3 +251,47 @@ fn tolerance_mode_is_exact_on_the_software_adapter() {
         assert_eq!(p.largest.relative, 0.0, "pass {}", p.pass);
     }
 }
+
+/// Issue 16: CSF surface tension with gas particles (curvature, the liquid's
+/// force), isothermal, 200 steps of the Laplace disc.
+#[test]
+fn surface_tension_static_drop_200_steps() {
+    assert_bit_identical("laplace_disc_2d", &[], 200);
+}
+
+/// The same drop hot inside a colder gas, with α(T), its clip at α_min, the F22
+/// (21) ramp above the liquid's solidus and the Marangoni term (∇T across and
+/// along the interface): the liquid starts at 1716 K, where α is clipped, and its
+/// surface cools below 1715 K, where it is not; the gas at 1500 K sits below the
+/// ramp (f = 0), the liquid above it (f = 1). Every branch of the pass.
+#[test]
+fn surface_tension_with_temperature_200_steps() {
+    let full = std::fs::read_to_string(common::scene("laplace_disc_2d")).unwrap();
+    // Without the Laplace check (it needs a constant coefficient).
+    let text = full[..full.find("[check]").unwrap()]
+        .replace(
+            "reference_pressure = 1000.0     # c = 1 m/s: sigma / R = 5 Pa is 0.5% of p0",
+            "reference_pressure = 1000.0\nconductivity = 20.0\nheat_capacity = 500.0\nsolidus = 1690.0\nliquidus = 1700.0\nlatent_heat = 1.0e4",
+        )
+        .replace(
+            "reference_pressure = 1000.0     # c = 3.2 m/s",
+            "reference_pressure = 1000.0\nconductivity = 0.5\nheat_capacity = 500.0",
+        )
+        .replace(
+            "kind = \"liquid\"\nmaterial = \"liquid\"",
+            "kind = \"liquid\"\nmaterial = \"liquid\"\ntemperature = 1716.0",
+        )
+        .replace(
+            "kind = \"gas\"\nmaterial = \"gas\"",
+            "kind = \"gas\"\nmaterial = \"gas\"\ntemperature = 1500.0",
+        )
+        .replace(
+            "coefficient = 0.1               # N/m",
+            "coefficient = 0.1\ntemperature_coefficient = -2.0e-3\nreference_temperature = 1700.0\nminimum = 0.07\nmelting_width = 20.0",
+        );
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_tension");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("hot_drop.toml");
+    std::fs::write(&path, text).unwrap();
+    assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
+}

@@ -333,5 +333,8 @@ fn a_time_step_200_times_the_limit_still_stops_within_a_few_steps() {
         .and_then(|s| s.parse().ok())
         .expect("step number");
     assert!(step <= 3, "{msg}");
-    assert!(msg.contains(": particle ") && msg.contains(", field "), "{msg}");
+    assert!(
+        msg.contains(": particle ") && msg.contains(", field "),
+        "{msg}"
+    );
 }

@@ -36,7 +36,7 @@ struct TimeStep {
     conduction_limit: f32,   // 0.1 rho c_p h²/k
     fixed_dt: f32,           // 0: adaptive
     barrier_limit: f32,      // 0.22 sqrt(m/k_b)
-    pad0: f32,
+    capillary_limit: f32,    // 0.25 sqrt(rho h^3/(2 pi alpha))
     pad1: f32,
     pad2: f32,
 }
@@ -51,6 +51,21 @@ struct Flow {
     barrier_damping: f32,     // d_b
     pad0: f32,
     pad1: f32,
+}
+
+struct Tension {             // F22 (24)-(26), (8), (21)
+    alpha0: f32,
+    alpha_slope: f32,
+    t_ref: f32,
+    alpha_min: f32,
+    t_melt: f32,             // ramp f[T, T_m, T_m + dT_s]
+    inv_ramp_width: f32,     // 1/dT_s (0: no ramp)
+    liquid: u32,
+    gas: u32,
+    pad0: u32,
+    pad3: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct Surfaces {
@@ -168,6 +183,7 @@ struct Params {
     time_step: TimeStep,
     flow: Flow,
     surfaces: Surfaces,
+    tension: Tension,
     laser: Laser,
     phases: array<Phase, 8>,
     consts: Consts,
@@ -189,6 +205,7 @@ const FLAG_VISCOUS_HEATING: u32 = 16u;
 const FLAG_HEAT: u32 = 32u;
 const FLAG_INTERFACE: u32 = 64u;
 const FLAG_GAS_INTERFACE: u32 = 128u;
+const FLAG_SURFACE_TENSION: u32 = 256u;
 const KIND_LIQUID: u32 = 0u;
 const KIND_GAS: u32 = 1u;
 const KIND_WALL: u32 = 2u;

@@ -5,7 +5,8 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, LASER_BEER_LAMBERT, LASER_SURFACE,
+    Params, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_SURFACE_TENSION,
+    LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -24,6 +25,8 @@ pub enum Stage {
     /// F22 (23) pressure + viscous forces, background pressure, interface
     /// viscosity, viscous heating, gravity.
     Forces,
+    /// F22 (24)–(26) CSF surface tension and Marangoni stress, added to acc.
+    SurfaceTension,
     /// Beer–Lambert absorption with column binning, or the Gaussian surface flux
     /// F22 (17); source (W/kg) in heat.w.
     Laser,
@@ -40,28 +43,30 @@ pub enum Stage {
 /// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
 /// previous step, then the temperatures following the new enthalpies.
-pub const STEP: [Stage; 11] = [
-    Stage::KickDrift,   // v += Δt/2 a, x += Δt ṽ (transport velocity)
-    Stage::Neighbors,   // sort by cell, cell table
-    Stage::Density,     // ρ = m Σ W, p = c² (ρ − ρ0)
-    Stage::Wall,        // wall pressure and velocity extrapolated from the fluid
-    Stage::Interface,   // interface normals and surface delta
-    Stage::Forces,      // pressure, viscous and surface forces; gravity
-    Stage::Laser,       // absorbed laser power
-    Stage::Heat,        // conduction and surface losses, enthalpy update
-    Stage::Temperature, // T and f_l from h; melting and solidification
-    Stage::Kick,        // v += Δt/2 a
-    Stage::Timestep,    // Δt for the next step
+pub const STEP: [Stage; 12] = [
+    Stage::KickDrift,      // v += Δt/2 a, x += Δt ṽ (transport velocity)
+    Stage::Neighbors,      // sort by cell, cell table
+    Stage::Density,        // ρ = m Σ W, p = c² (ρ − ρ0)
+    Stage::Wall,           // wall pressure and velocity extrapolated from the fluid
+    Stage::Interface,      // interface normals and surface delta
+    Stage::Forces,         // pressure, viscous forces, barrier; gravity
+    Stage::SurfaceTension, // curvature and Marangoni stress
+    Stage::Laser,          // absorbed laser power
+    Stage::Heat,           // conduction and surface losses, enthalpy update
+    Stage::Temperature,    // T and f_l from h; melting and solidification
+    Stage::Kick,           // v += Δt/2 a
+    Stage::Timestep,       // Δt for the next step
 ];
 
 /// Run once before the first step: accelerations, temperatures and Δt of the
 /// initial state.
-pub const PRIME: [Stage; 7] = [
+pub const PRIME: [Stage; 8] = [
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Interface,
     Stage::Forces,
+    Stage::SurfaceTension,
     Stage::Temperature,
     Stage::Timestep,
 ];
@@ -83,6 +88,8 @@ pub struct Features {
     pub laser_bins: bool,
     /// Gaussian surface-flux laser.
     pub laser_surface: bool,
+    /// F22 (24)–(26) surface tension.
+    pub surface_tension: bool,
 }
 
 impl Features {
@@ -99,6 +106,7 @@ impl Features {
             gas_interface: params.flag(FLAG_GAS_INTERFACE),
             laser_bins: params.laser.model == LASER_BEER_LAMBERT,
             laser_surface: params.laser.model == LASER_SURFACE,
+            surface_tension: params.flag(FLAG_SURFACE_TENSION),
         }
     }
 }
@@ -150,7 +158,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 11] = [
+pub const STAGES: [StageDef; 12] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -205,6 +213,14 @@ pub const STAGES: [StageDef; 11] = [
         needed: |f| f.fluid,
         gpu: &[always("forces", Work::Particles)],
         cpu: |b| b.forces(),
+    },
+    StageDef {
+        stage: Stage::SurfaceTension,
+        name: "surface_tension",
+        file: "surface_tension",
+        needed: |f| f.surface_tension,
+        gpu: &[always("surface_tension", Work::Particles)],
+        cpu: |b| b.surface_tension(),
     },
     StageDef {
         stage: Stage::Laser,
@@ -320,6 +336,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 21);
+        assert_eq!(e.len(), 22);
     }
 }

@@ -90,6 +90,16 @@ pub const SWEEPS: &[Sweep] = &[
         quick: false,
     },
     Sweep {
+        name: "laplace_disc_2d",
+        text: scene_text!("laplace_disc_2d"),
+        // The disc's radius: R = 10, 20, 40 Δx.
+        length: 0.02,
+        cells: &[10, 20, 40],
+        expected_order: Some(1.0),
+        why: "the CSF force sits on the first liquid row, whose curvature and surface delta are O(dx/R)",
+        quick: false,
+    },
+    Sweep {
         name: "conduction_1d",
         text: scene_text!("conduction_1d"),
         length: 0.01,

@@ -10,6 +10,7 @@ mod compression;
 mod dam_break;
 mod flow;
 mod heat;
+mod tension;
 mod two_layer;
 
 pub use dam_break::{fit_release_delay, ReleaseDelayFit};
@@ -122,6 +123,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         )),
         CheckKind::TwoLayer => Box::new(two_layer::TwoLayer::default()),
         CheckKind::Compression => Box::new(compression::Compression::default()),
+        CheckKind::Laplace => Box::new(tension::Laplace::new(m, c)),
         CheckKind::Conduction1d => Box::new(heat::Conduction1d),
         CheckKind::ConductionTwoMaterials => Box::new(heat::TwoMaterials {
             interface: c.surface.unwrap_or(f64::NAN),
@@ -141,8 +143,9 @@ pub(super) struct P {
     kind: PhaseKind,
 }
 
+/// The particles still in the simulation (those that left are not sampled).
 pub(super) fn particles<'a>(m: &'a Model, st: &'a State) -> impl Iterator<Item = P> + 'a {
-    (0..st.len()).map(move |i| {
+    (0..st.active()).map(move |i| {
         let x = st.pos[i];
         let v = st.vel[i];
         P {

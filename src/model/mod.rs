@@ -4,10 +4,12 @@
 mod domain;
 mod laser;
 mod phases;
+mod tension;
 mod thermal;
 
 pub use laser::{Laser, MAX_LASER_POINTS};
 pub use phases::{Evaporation, PhaseInfo, Thermal};
+pub use tension::SurfaceTension;
 
 use domain::{
     box_face_warnings, cell_grid, check_walls, domain_box, domain_sites, hydrostatic_axis,
@@ -39,6 +41,9 @@ pub struct DtLimits {
     pub conduction: f64,
     /// F22 (42) 0.22 √(m/k_b) with the lightest fluid particle; ∞ without barrier.
     pub barrier: f64,
+    /// F22 (42) 0.25 √(ρ h³/(2π α)), the lighter of the pair's ρ0 and the largest
+    /// α the scene can reach; ∞ without surface tension.
+    pub capillary: f64,
 }
 
 impl DtLimits {
@@ -55,6 +60,9 @@ impl DtLimits {
         }
         if self.barrier < best.0 {
             best = (self.barrier, "barrier 0.22 sqrt(m/k_b)");
+        }
+        if self.capillary < best.0 {
+            best = (self.capillary, "capillary 0.25 sqrt(rho h^3/(2 pi alpha))");
         }
         best
     }
@@ -107,6 +115,8 @@ pub struct Model {
     pub laser: Option<Laser>,
     /// F22 (34) barrier between fluid and walls.
     pub barrier: Option<Barrier>,
+    /// F22 (24)–(26) surface tension between a liquid and a gas phase.
+    pub surface_tension: Option<SurfaceTension>,
     pub limits: DtLimits,
 }
 
@@ -135,7 +145,10 @@ impl Model {
             .laser
             .as_ref()
             .is_some_and(|l| l.model == crate::scene::LaserModel::GaussianSurface);
-        surface_laser || self.has_surface_losses() || self.interface_viscosity > 0.0
+        surface_laser
+            || self.has_surface_losses()
+            || self.interface_viscosity > 0.0
+            || self.surface_tension.is_some()
     }
     pub fn has_surface_losses(&self) -> bool {
         self.phases
@@ -312,6 +325,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .fold(interface_viscosity_nu(&cx, sim, &fluid, dim, h)?, f64::max);
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
+    let surface_tension = tension::surface_tension(&cx, scene, &phases)?;
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
             0.25 * h / c_max
@@ -336,6 +350,11 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             }
             None => f64::INFINITY,
         },
+        capillary: surface_tension.as_ref().map_or(f64::INFINITY, |s| {
+            let rho = phases[s.liquid].rho0.min(phases[s.gas].rho0);
+            0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(&phases)))
+                .sqrt()
+        }),
     };
 
     let run = &scene.run;
@@ -374,6 +393,16 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     };
     if let Some(c) = &scene.check {
         cx.positive("check.tolerance", c.tolerance)?;
+        if c.kind == crate::scene::CheckKind::Laplace {
+            cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
+            cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
+            if !surface_tension.as_ref().is_some_and(|s| s.slope == 0.0) {
+                return Err(cx.err(
+                    "check.kind",
+                    "\"laplace\" needs [surface_tension] with a constant coefficient",
+                ));
+            }
+        }
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
     let wd = &scene.watchdog;
@@ -437,6 +466,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         watchdog: scene.watchdog.clone(),
         laser,
         barrier,
+        surface_tension,
         limits,
     })
 }

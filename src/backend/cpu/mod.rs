@@ -9,6 +9,7 @@ mod integrate;
 mod interface;
 mod laser;
 mod neighbors;
+mod surface_tension;
 mod terms;
 mod timestep;
 mod wall;
@@ -82,6 +83,9 @@ impl CpuBackend {
     }
     pub(crate) fn forces(&mut self) {
         forces::run(&self.params, &mut self.st, &self.grid, &self.list)
+    }
+    pub(crate) fn surface_tension(&mut self) {
+        surface_tension::run(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn laser(&mut self) {
         let pr = &self.params;

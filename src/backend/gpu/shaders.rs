@@ -36,7 +36,7 @@ const LIBS: [(&str, &str); 7] = [
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
-pub const PASSES: [(&str, &str); 9] = [
+pub const PASSES: [(&str, &str); 10] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
@@ -46,6 +46,10 @@ pub const PASSES: [(&str, &str); 9] = [
     ("heat", include_str!("../../../shaders/heat.wgsl")),
     ("laser", include_str!("../../../shaders/laser.wgsl")),
     ("interface", include_str!("../../../shaders/interface.wgsl")),
+    (
+        "surface_tension",
+        include_str!("../../../shaders/surface_tension.wgsl"),
+    ),
 ];
 
 const WALK_DIRECTIVE: &str = "#for_each_neighbor(";

@@ -1,0 +1,116 @@
+// uses: params bindings consts kernel grid phase
+// writes: acc surface
+// CSF surface tension with Marangoni stress, F22 (24)-(26), (8), (21), between the
+// liquid and the gas of P.tension, added to the acceleration the forces pass
+// wrote. Curvature kappa_i (Morris 2000, F22 (25)) goes to surface[n + i].y.
+// Twin of src/backend/cpu/surface_tension.rs (equations and choices there).
+
+// F22 (21) f[T, T_m, T_m + dT_s]; 1 without a ramp.
+fn tension_ramp(t: f32) -> f32 {
+    if (P.tension.inv_ramp_width == 0.0) {
+        return c_one();
+    }
+    return min(max((t - P.tension.t_melt) * P.tension.inv_ramp_width, 0.0), c_one());
+}
+
+fn in_tension_pair(ph: u32) -> bool {
+    return ph == P.tension.liquid || ph == P.tension.gas;
+}
+
+// Temperature of a particle (0 in scenes without heat).
+fn tension_temperature(j: u32) -> f32 {
+    if ((P.sizes.flags & FLAG_HEAT) == 0u) {
+        return 0.0;
+    }
+    return heat[j].y;
+}
+
+// Carries a temperature for the gradient F22 (26): conducting, or a Dirichlet wall.
+fn has_temperature(ph: u32) -> bool {
+    return conducts(ph) || ((P.sizes.flags & FLAG_HEAT) != 0u && (heat_flags(ph) & HEAT_DIRICHLET) != 0u);
+}
+
+// Volume for the temperature gradient: m/rho for fluids, m/rho0 for solids and walls.
+fn tension_volume(j: u32) -> f32 {
+    let ph = phase[j];
+    if (is_wall(ph)) {
+        return mass[j] / P.phases[ph].rho0;
+    }
+    return mass[j] / rho[j];
+}
+
+@compute @workgroup_size(64)
+fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let n = P.sizes.n_particles;
+    let ph_i = phase[i];
+    if (!in_tension_pair(ph_i)) { return; }
+    let liquid_i = ph_i == P.tension.liquid;
+    let s_i = surface[i];
+    if (s_i.w == 0.0) {
+        surface[n + i].y = 0.0;
+        return;
+    }
+    let heated = (P.sizes.flags & FLAG_HEAT) != 0u;
+    let t_i = tension_temperature(i);
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var num = 0.0;
+    var den = 0.0;
+    var gt = vec3<f32>(0.0);
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kernel.support2) {
+            let ph_j = phase[j];
+            let r = sqrt(r2);
+            let s_j = surface[j];
+            if (in_tension_pair(ph_j) && s_j.w != 0.0) {
+                let v_j = mass[j] / rho[j];
+                let fv = tension_ramp(tension_temperature(j)) * v_j;
+                den = den + fv * kernel_w(r);
+                if (r2 > 0.0) {
+                    var nj = s_j.xyz;
+                    if ((ph_j == P.tension.liquid) != liquid_i) {
+                        nj = -nj;
+                    }
+                    let dn = (s_i.x - nj.x) * d.x + (s_i.y - nj.y) * d.y + (s_i.z - nj.z) * d.z;
+                    num = num + fv * (dn / r) * kernel_dw(r);
+                }
+            }
+            if (heated && r2 > 0.0 && has_temperature(ph_j)) {
+                let g = tension_volume(j) * (heat[j].y - t_i) * kernel_dw(r) / r;
+                gt.x = gt.x + g * d.x;
+                gt.y = gt.y + g * d.y;
+                gt.z = gt.z + g * d.z;
+            }
+        }
+    }
+    var kappa = 0.0;
+    if (den > 0.0) {
+        kappa = -(num / den);
+    }
+    surface[n + i].y = kappa;
+    if (!liquid_i) { return; }
+    let raw = P.tension.alpha0 + P.tension.alpha_slope * (t_i - P.tension.t_ref);
+    var alpha = raw;
+    var slope = P.tension.alpha_slope;
+    if (raw <= P.tension.alpha_min) {
+        alpha = P.tension.alpha_min;
+        slope = 0.0;
+    }
+    let delta = s_i.w;
+    let nt = s_i.x * gt.x + s_i.y * gt.y + s_i.z * gt.z;
+    let tx = gt.x - nt * s_i.x;
+    let ty = gt.y - nt * s_i.y;
+    let tz = gt.z - nt * s_i.z;
+    let scale = tension_ramp(t_i) * delta / rho[i];
+    let normal = alpha * kappa;
+    var a = acc[i];
+    a.x = a.x + scale * (slope * tx - normal * s_i.x);
+    a.y = a.y + scale * (slope * ty - normal * s_i.y);
+    a.z = a.z + scale * (slope * tz - normal * s_i.z);
+    acc[i] = a;
+}

@@ -1,0 +1,146 @@
+//! Twin of shaders/surface_tension.wgsl: CSF surface tension with the Marangoni
+//! stress, F22 (24), between the liquid and the gas of `Params::tension`:
+//!   a_i = f[T_i] (−α_i κ_i δ_i n_i + α'_i δ_i ∇_t T_i) / ρ_i,
+//! added to the acceleration of the forces pass, for liquid particles with an
+//! interface normal (F22 (19)–(20), the interface pass). Choices F22 leaves open:
+//! - Curvature F22 (25), Morris (2000): κ_i = −Σ_j f_j V_j (n_i − n_j)·e_ij W'_ij /
+//!   Σ_j f_j V_j W_ij over the pair's particles j that have a normal (j = i
+//!   included in the sum below): Morris' restriction to reliable normals. A
+//!   normal of the other phase points the other way (F22 (20): outward from its
+//!   own phase) and enters negated, so the field is continuous across the
+//!   interface.
+//! - The force acts on the liquid side only. F22 applies (24) to gas particles
+//!   too, but its δ (19) weights each side by ρ_i/(ρ_i + ρ_j): the gas side holds
+//!   ρ_g/(ρ_l + ρ_g) of the flux (Remark 3) and at density ratios ≥ 10 falls
+//!   mostly below the normal threshold (20), which drops that share. The
+//!   interface pass normalises the liquid side's δ to integrate to 1 across a flat
+//!   lattice surface (the laser's flux), so the force per unit area is α κ.
+//!   Gas particles still get κ (diagnostics) and lend their normals to the
+//!   curvature.
+//! - α(T) = max(α0 + α0'(T − T_α0), α_min) (F22 (8)); α' = α0' where α is not
+//!   clipped and 0 where it is (α is constant there).
+//! - ∇T_i = Σ_j V_j (T_j − T_i) W'_ij e_ij over every neighbour with a temperature
+//!   (F22 (26): all phases; Dirichlet walls included), ∇_t T = ∇T − (n·∇T) n.
+//! - f = F22 (21) ramp from the liquid's solidus over ΔT_s, in heat scenes whose
+//!   liquid melts; 1 otherwise.
+
+use super::neighbors::{for_each_neighbor, CellTable};
+use crate::kernel;
+use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET};
+use crate::state::State;
+use rayon::prelude::*;
+
+/// F22 (21) f[T, T_m, T_m + ΔT_s]; 1 without a ramp. max then min, as the WGSL
+/// twin writes it (clamp differs for NaN).
+#[inline(always)]
+#[allow(clippy::manual_clamp)]
+fn ramp(pr: &Params, t: f32) -> f32 {
+    let s = &pr.tension;
+    if s.inv_ramp_width == 0.0 {
+        return 1.0;
+    }
+    ((t - s.t_melt) * s.inv_ramp_width).max(0.0).min(1.0)
+}
+
+#[inline(always)]
+fn in_pair(pr: &Params, ph: u32) -> bool {
+    ph == pr.tension.liquid || ph == pr.tension.gas
+}
+
+pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
+    let (n, active) = (st.len(), st.active());
+    let heated = pr.flag(FLAG_HEAT);
+    let s: &State = st;
+    let temperature = |j: usize| if heated { s.heat[j][1] } else { 0.0 };
+    let has_temperature =
+        |ph: u32| pr.conducts(ph) || (heated && pr.heat_flags(ph) & HEAT_DIRICHLET != 0);
+    let volume = |j: usize| {
+        let ph = s.phase[j];
+        if pr.is_wall(ph) {
+            s.mass[j] / pr.phases[ph as usize].rho0
+        } else {
+            s.mass[j] / s.rho[j]
+        }
+    };
+    // Per particle of the pair: its acceleration (None without a normal) and κ.
+    let out: Vec<Option<(Option<[f32; 3]>, f32)>> = (0..active)
+        .into_par_iter()
+        .map(|i| {
+            let ph_i = s.phase[i];
+            if !in_pair(pr, ph_i) {
+                return None;
+            }
+            let n_i = s.surface[i];
+            if n_i[3] == 0.0 {
+                return Some((None, 0.0));
+            }
+            let liquid_i = ph_i == pr.tension.liquid;
+            let t_i = temperature(i);
+            let (mut num, mut den) = (0.0f32, 0.0f32);
+            let mut gt = [0.0f32; 3];
+            for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+                let ph_j = s.phase[j];
+                let r = r2.sqrt();
+                let n_j = s.surface[j];
+                if in_pair(pr, ph_j) && n_j[3] != 0.0 {
+                    let v_j = s.mass[j] / s.rho[j];
+                    let fv = ramp(pr, temperature(j)) * v_j;
+                    den += fv * kernel::w(pr, r);
+                    if r2 > 0.0 {
+                        let sign = if (ph_j == pr.tension.liquid) != liquid_i {
+                            -1.0
+                        } else {
+                            1.0
+                        };
+                        let nj = [sign * n_j[0], sign * n_j[1], sign * n_j[2]];
+                        let dn = (n_i[0] - nj[0]) * d[0]
+                            + (n_i[1] - nj[1]) * d[1]
+                            + (n_i[2] - nj[2]) * d[2];
+                        num += fv * (dn / r) * kernel::dw(pr, r);
+                    }
+                }
+                if heated && r2 > 0.0 && has_temperature(ph_j) {
+                    let g = volume(j) * (s.heat[j][1] - t_i) * kernel::dw(pr, r) / r;
+                    for a in 0..3 {
+                        gt[a] += g * d[a];
+                    }
+                }
+            });
+            let kappa = if den > 0.0 { -(num / den) } else { 0.0 };
+            if !liquid_i {
+                return Some((None, kappa));
+            }
+            let t = &pr.tension;
+            let raw = t.alpha0 + t.alpha_slope * (t_i - t.t_ref);
+            let (alpha, slope) = if raw <= t.alpha_min {
+                (t.alpha_min, 0.0)
+            } else {
+                (raw, t.alpha_slope)
+            };
+            let delta = n_i[3];
+            let nt = n_i[0] * gt[0] + n_i[1] * gt[1] + n_i[2] * gt[2];
+            let tan = [
+                gt[0] - nt * n_i[0],
+                gt[1] - nt * n_i[1],
+                gt[2] - nt * n_i[2],
+            ];
+            let scale = ramp(pr, t_i) * delta / s.rho[i];
+            let normal = alpha * kappa;
+            let a = [
+                scale * (slope * tan[0] - normal * n_i[0]),
+                scale * (slope * tan[1] - normal * n_i[1]),
+                scale * (slope * tan[2] - normal * n_i[2]),
+            ];
+            Some((Some(a), kappa))
+        })
+        .collect();
+    for (i, o) in out.into_iter().enumerate() {
+        let Some((a, kappa)) = o else { continue };
+        if let Some(a) = a {
+            for c in 0..3 {
+                st.acc[i][c] += a[c];
+            }
+        }
+        st.surface[n + i][1] = kappa;
+    }
+}

@@ -1,0 +1,130 @@
+//! Surface-tension checks (issue 16).
+
+use super::{particles, Check, Verdict};
+use crate::model::Model;
+use crate::scene::{CheckDef, PhaseKind};
+use crate::state::State;
+
+/// Laplace pressure of a drop at rest: the mean pressure of the liquid more than
+/// one kernel support inside the surface, minus that of the gas more than one
+/// support outside it, against σ/R (2D) or 2σ/R (3D). The jump is averaged over
+/// the samples of the run's second half (the drop oscillates about rest and
+/// settles; one sample carries the acoustic noise). The largest speed of those
+/// samples (spurious currents) is reported, and as a capillary number η|u|/σ.
+pub struct Laplace {
+    center: [f64; 3],
+    radius: f64,
+    samples: Vec<Sample>,
+}
+
+struct Sample {
+    time: f64,
+    jump: f64,
+    max_speed: f64,
+}
+
+impl Laplace {
+    pub fn new(m: &Model, c: &CheckDef) -> Laplace {
+        let mut center = [0.0; 3];
+        for (a, x) in c.center.iter().flatten().enumerate().take(m.dim as usize) {
+            center[a] = *x;
+        }
+        Laplace {
+            center,
+            radius: c.radius.unwrap_or(f64::NAN),
+            samples: Vec::new(),
+        }
+    }
+
+    fn reference(&self, m: &Model) -> f64 {
+        let sigma = m
+            .surface_tension
+            .as_ref()
+            .map_or(f64::NAN, |s| s.coefficient);
+        (m.dim as f64 - 1.0) * sigma / self.radius
+    }
+}
+
+impl Check for Laplace {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let band = m.support;
+        let (mut inside, mut outside) = ((0.0, 0usize), (0.0, 0usize));
+        let mut max_speed: f64 = 0.0;
+        for p in particles(m, st) {
+            let r = (0..3)
+                .map(|a| (p.x[a] - self.center[a]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let speed = (p.v[0] * p.v[0] + p.v[1] * p.v[1] + p.v[2] * p.v[2]).sqrt();
+            if p.kind == PhaseKind::Liquid || p.kind == PhaseKind::Gas {
+                max_speed = max_speed.max(speed);
+            }
+            if p.kind == PhaseKind::Liquid && r < self.radius - band {
+                inside = (inside.0 + p.p, inside.1 + 1);
+            } else if p.kind == PhaseKind::Gas && r > self.radius + band {
+                outside = (outside.0 + p.p, outside.1 + 1);
+            }
+        }
+        if inside.1 == 0 || outside.1 == 0 {
+            return;
+        }
+        self.samples.push(Sample {
+            time: st.sim.time as f64,
+            jump: inside.0 / inside.1 as f64 - outside.0 / outside.1 as f64,
+            max_speed,
+        });
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let reference = self.reference(m);
+        let end = st.sim.time as f64;
+        let late: Vec<&Sample> = self
+            .samples
+            .iter()
+            .filter(|s| s.time >= 0.5 * end)
+            .collect();
+        let metric =
+            "relative error of the mean pressure jump over the run's second half".to_string();
+        if late.is_empty() {
+            return (
+                metric,
+                f64::NAN,
+                vec!["  no sample in the run's second half".into()],
+            )
+                .into();
+        }
+        let jump = late.iter().map(|s| s.jump).sum::<f64>() / late.len() as f64;
+        let speed = late.iter().map(|s| s.max_speed).fold(0.0, f64::max);
+        let st_def = m
+            .surface_tension
+            .as_ref()
+            .expect("laplace needs surface tension");
+        let eta = m.phases[st_def.liquid].viscosity;
+        let sigma = st_def.coefficient;
+        let error = (jump - reference).abs() / reference;
+        let details = vec![
+            format!(
+                "  pressure jump {jump:.5e} Pa (mean of {} samples from t = {:.3e} s), Laplace {reference:.5e} Pa (R = {:.4e} m = {:.1} dx)",
+                late.len(),
+                0.5 * end,
+                self.radius,
+                self.radius / m.dx
+            ),
+            format!(
+                "  spurious currents: largest speed {speed:.3e} m/s, capillary number eta |u| / sigma = {:.3e}",
+                eta * speed / sigma
+            ),
+        ];
+        Verdict {
+            metric,
+            value: error,
+            details,
+            figures: vec![
+                ("pressure_jump".into(), jump),
+                ("laplace_pressure".into(), reference),
+                ("max_speed".into(), speed),
+                ("capillary_number".into(), eta * speed / sigma),
+            ],
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! Surface tension between a liquid and a gas phase, F22 (24)–(26) with the law
+//! F22 (8) and the regularisation F22 (21), from `[surface_tension]`.
+
+use super::*;
+
+/// F22 (8): α(T) = max(α0 + α0' (T − T_α0), α_min); α' = α0' where α is not
+/// clipped, 0 where it is (α is constant there, so the Marangoni stress is 0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceTension {
+    /// Phase indices.
+    pub liquid: usize,
+    pub gas: usize,
+    pub coefficient: f64,
+    pub slope: f64,
+    pub reference_temperature: f64,
+    pub minimum: f64,
+    /// (T_m, ΔT_s): the liquid's solidus and the ramp width above it, in heat
+    /// scenes whose liquid melts; None: no regularisation (f = 1).
+    pub ramp: Option<(f64, f64)>,
+}
+
+impl SurfaceTension {
+    pub fn coefficient_at(&self, t: f64) -> f64 {
+        (self.coefficient + self.slope * (t - self.reference_temperature)).max(self.minimum)
+    }
+    /// The largest α any particle can feel (for the capillary Δt limit): at the
+    /// ramp's start when regularised, else at the coldest temperature the scene
+    /// starts with (α falls with T).
+    pub fn max_coefficient(&self, phases: &[PhaseInfo]) -> f64 {
+        let t_low = match self.ramp {
+            Some((t_m, _)) => t_m,
+            None => phases
+                .iter()
+                .filter_map(|p| p.thermal.map(|t| t.temperature))
+                .fold(self.reference_temperature, f64::min),
+        };
+        self.coefficient_at(t_low)
+    }
+}
+
+pub(super) fn surface_tension(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &[PhaseInfo],
+) -> Result<Option<SurfaceTension>, InputError> {
+    let Some(d) = &scene.surface_tension else {
+        return Ok(None);
+    };
+    let phase = |key: &str, name: &str, kind: PhaseKind| -> Result<usize, InputError> {
+        let i = phases
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| cx.err(key, format!("no phase named `{name}`")))?;
+        if phases[i].kind != kind {
+            return Err(cx.err(
+                key,
+                format!("`{name}` is not a phase of kind {kind:?}").to_lowercase(),
+            ));
+        }
+        Ok(i)
+    };
+    let liquid = phase("surface_tension.liquid", &d.liquid, PhaseKind::Liquid)?;
+    let gas = phase("surface_tension.gas", &d.gas, PhaseKind::Gas)?;
+    let coefficient = cx.positive("surface_tension.coefficient", d.coefficient)?;
+    if !(d.temperature_coefficient.is_finite() && d.temperature_coefficient <= 0.0) {
+        return Err(cx.err(
+            "surface_tension.temperature_coefficient",
+            format!("must be zero or negative (F22 (8): surface tension falls with temperature), got {}", d.temperature_coefficient),
+        ));
+    }
+    let heat = phases[liquid].thermal.is_some();
+    let reference_temperature = match (d.temperature_coefficient != 0.0, d.reference_temperature) {
+        (_, Some(t)) => cx.positive("surface_tension.reference_temperature", t)?,
+        (true, None) => return Err(cx.err(
+            "surface_tension.reference_temperature",
+            "missing: a temperature coefficient needs the temperature T_α0 where α = coefficient",
+        )),
+        (false, None) => 0.0,
+    };
+    if d.temperature_coefficient != 0.0 && !heat {
+        return Err(cx.err(
+            "surface_tension.temperature_coefficient",
+            format!(
+                "needs a heat scene (phase `{}` has no temperature)",
+                d.liquid
+            ),
+        ));
+    }
+    let minimum = cx.non_negative("surface_tension.minimum", d.minimum)?;
+    if minimum >= coefficient {
+        return Err(cx.err(
+            "surface_tension.minimum",
+            format!("must be below the coefficient {coefficient} N/m, got {minimum}"),
+        ));
+    }
+    let solidus = phases[liquid].thermal.and_then(|t| t.melting).map(|m| m.0);
+    let ramp = match (solidus, d.melting_width) {
+        (Some(t_m), Some(w)) => Some((t_m, cx.positive("surface_tension.melting_width", w)?)),
+        (Some(_), None) => {
+            return Err(cx.err(
+                "surface_tension.melting_width",
+                format!("missing: the liquid `{}` melts, and F22 (21) ramps its surface tension in over ΔT_s above the solidus (F22: 5 K)", d.liquid),
+            ))
+        }
+        (None, Some(_)) => {
+            return Err(cx.err(
+                "surface_tension.melting_width",
+                format!("the liquid `{}` has no melting range (solidus) to ramp from", d.liquid),
+            ))
+        }
+        (None, None) => None,
+    };
+    Ok(Some(SurfaceTension {
+        liquid,
+        gas,
+        coefficient,
+        slope: d.temperature_coefficient,
+        reference_temperature,
+        minimum,
+        ramp,
+    }))
+}

@@ -1,4 +1,4 @@
-// uses: params bindings consts kernel grid phase math
+// uses: params bindings consts kernel grid phase math vapour
 // writes: acc acc_b heat phase vel
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
@@ -104,7 +104,7 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
     var flux = 0.0;
     if (P.phases[ph].evap_pressure > 0.0) {
-        let pv = P.phases[ph].evap_pressure * pm_exp(-(P.phases[ph].evap_temperature * (c_one() / t - P.phases[ph].inv_boiling_temperature)));
+        let pv = vapour_pressure(ph, t);
         let mdot = P.phases[ph].recondensation * pv * sqrt(P.phases[ph].vapor_constant / t);
         flux = flux + mdot * (P.phases[ph].evap_latent_heat + P.phases[ph].liquid_heat_capacity * (t - P.phases[ph].evap_enthalpy_reference));
     }

@@ -29,6 +29,8 @@ pub const FLAG_INTERFACE: u32 = 64;
 pub const FLAG_GAS_INTERFACE: u32 = 128;
 /// F22 (24)–(26) surface tension between `tension.liquid` and `tension.gas`.
 pub const FLAG_SURFACE_TENSION: u32 = 256;
+/// Some phase takes the F22 (30) recoil pressure (PHASE_RECOIL).
+pub const FLAG_RECOIL: u32 = 512;
 
 /// `Phase::kind`.
 pub const KIND_LIQUID: u32 = 0;
@@ -46,6 +48,8 @@ pub const HEAT_SWITCH_SHIFT: u32 = 8;
 pub const PHASE_FREE_SLIP: u32 = 1 << 12;
 /// A wall phase whose particles drift with its velocity.
 pub const PHASE_MOVES: u32 = 1 << 13;
+/// A liquid phase that takes the F22 (30) recoil pressure at its surface.
+pub const PHASE_RECOIL: u32 = 1 << 14;
 
 /// `Laser::model` codes (0: no laser).
 pub const LASER_BEER_LAMBERT: u32 = 1;
@@ -474,6 +478,10 @@ impl Params {
             p.surfaces.ambient_t4 = m.ambient_temperature.powi(4) as f32;
             p.flow.interface_viscosity = m.interface_viscosity as f32;
         }
+        let recoil = (0..m.phases.len()).any(|i| p.phases[i].flags & PHASE_RECOIL != 0);
+        if recoil && m.needs_interface() {
+            p.sizes.flags |= FLAG_RECOIL;
+        }
         if let Some(s) = &m.surface_tension {
             p.sizes.flags |= FLAG_SURFACE_TENSION;
             let t = &mut p.tension;
@@ -815,6 +823,9 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
         b.evap_enthalpy_reference = v.enthalpy_reference as f32;
         b.vapor_constant = v.vapor_constant as f32;
         b.recondensation = (0.82 * v.sticking) as f32;
+        if v.recoil && ph.kind == PhaseKind::Liquid {
+            b.flags |= PHASE_RECOIL;
+        }
     }
     b.emissivity_sb = (t.emissivity * STEFAN_BOLTZMANN) as f32;
     b

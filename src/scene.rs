@@ -326,6 +326,14 @@ pub struct EvaporationDef {
     /// c_s, close to one for metals.
     #[serde(default = "one")]
     pub sticking: f64,
+    /// F22 (30): the vapour's recoil pressure p_v(T) pushes the liquid's surface,
+    /// −p_v δ n per unit volume (liquid phases). On unless set false.
+    #[serde(default = "yes")]
+    pub recoil: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn one() -> f64 {
@@ -459,6 +467,8 @@ pub struct CheckDef {
     /// Laplace: centre and radius of the drop (m).
     pub center: Option<Vec<f64>>,
     pub radius: Option<f64>,
+    /// Recoil impulse: area of the hot surface (m², m per metre of depth in 2D).
+    pub area: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -500,6 +510,8 @@ pub enum CheckKind {
     Compression,
     /// Pressure jump across a drop's surface against Laplace's σ/R (2D), 2σ/R (3D).
     Laplace,
+    /// Momentum a free layer gains from the recoil pressure against −∫ p_v A dt.
+    RecoilImpulse,
 }
 
 impl CheckKind {
@@ -519,6 +531,7 @@ impl CheckKind {
             CheckKind::Rosenthal => "rosenthal",
             CheckKind::Compression => "compression",
             CheckKind::Laplace => "laplace",
+            CheckKind::RecoilImpulse => "recoil_impulse",
         }
     }
 }

@@ -5,7 +5,7 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_SURFACE_TENSION,
+    Params, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL, FLAG_SURFACE_TENSION,
     LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
@@ -25,8 +25,9 @@ pub enum Stage {
     /// F22 (23) pressure + viscous forces, background pressure, interface
     /// viscosity, viscous heating, gravity.
     Forces,
-    /// F22 (24)–(26) CSF surface tension and Marangoni stress, added to acc.
-    SurfaceTension,
+    /// F22 (24)–(26) CSF surface tension and Marangoni stress, F22 (30) recoil,
+    /// added to acc.
+    SurfaceForces,
     /// Beer–Lambert absorption with column binning, or the Gaussian surface flux
     /// F22 (17); source (W/kg) in heat.w.
     Laser,
@@ -44,18 +45,18 @@ pub enum Stage {
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
 /// previous step, then the temperatures following the new enthalpies.
 pub const STEP: [Stage; 12] = [
-    Stage::KickDrift,      // v += Δt/2 a, x += Δt ṽ (transport velocity)
-    Stage::Neighbors,      // sort by cell, cell table
-    Stage::Density,        // ρ = m Σ W, p = c² (ρ − ρ0)
-    Stage::Wall,           // wall pressure and velocity extrapolated from the fluid
-    Stage::Interface,      // interface normals and surface delta
-    Stage::Forces,         // pressure, viscous forces, barrier; gravity
-    Stage::SurfaceTension, // curvature and Marangoni stress
-    Stage::Laser,          // absorbed laser power
-    Stage::Heat,           // conduction and surface losses, enthalpy update
-    Stage::Temperature,    // T and f_l from h; melting and solidification
-    Stage::Kick,           // v += Δt/2 a
-    Stage::Timestep,       // Δt for the next step
+    Stage::KickDrift,     // v += Δt/2 a, x += Δt ṽ (transport velocity)
+    Stage::Neighbors,     // sort by cell, cell table
+    Stage::Density,       // ρ = m Σ W, p = c² (ρ − ρ0)
+    Stage::Wall,          // wall pressure and velocity extrapolated from the fluid
+    Stage::Interface,     // interface normals and surface delta
+    Stage::Forces,        // pressure, viscous forces, barrier; gravity
+    Stage::SurfaceForces, // surface tension, Marangoni stress, recoil
+    Stage::Laser,         // absorbed laser power
+    Stage::Heat,          // conduction and surface losses, enthalpy update
+    Stage::Temperature,   // T and f_l from h; melting and solidification
+    Stage::Kick,          // v += Δt/2 a
+    Stage::Timestep,      // Δt for the next step
 ];
 
 /// Run once before the first step: accelerations, temperatures and Δt of the
@@ -66,7 +67,7 @@ pub const PRIME: [Stage; 8] = [
     Stage::Wall,
     Stage::Interface,
     Stage::Forces,
-    Stage::SurfaceTension,
+    Stage::SurfaceForces,
     Stage::Temperature,
     Stage::Timestep,
 ];
@@ -90,6 +91,8 @@ pub struct Features {
     pub laser_surface: bool,
     /// F22 (24)–(26) surface tension.
     pub surface_tension: bool,
+    /// F22 (30) recoil pressure.
+    pub recoil: bool,
 }
 
 impl Features {
@@ -107,6 +110,7 @@ impl Features {
             laser_bins: params.laser.model == LASER_BEER_LAMBERT,
             laser_surface: params.laser.model == LASER_SURFACE,
             surface_tension: params.flag(FLAG_SURFACE_TENSION),
+            recoil: params.flag(FLAG_RECOIL),
         }
     }
 }
@@ -215,12 +219,23 @@ pub const STAGES: [StageDef; 12] = [
         cpu: |b| b.forces(),
     },
     StageDef {
-        stage: Stage::SurfaceTension,
-        name: "surface_tension",
-        file: "surface_tension",
-        needed: |f| f.surface_tension,
-        gpu: &[always("surface_tension", Work::Particles)],
-        cpu: |b| b.surface_tension(),
+        stage: Stage::SurfaceForces,
+        name: "surface_forces",
+        file: "surface_forces",
+        needed: |f| f.surface_tension || f.recoil,
+        gpu: &[
+            Dispatch {
+                entry: "surface_tension",
+                work: Work::Particles,
+                when: |f| f.surface_tension,
+            },
+            Dispatch {
+                entry: "recoil",
+                work: Work::Particles,
+                when: |f| f.recoil,
+            },
+        ],
+        cpu: |b| b.surface_forces(),
     },
     StageDef {
         stage: Stage::Laser,
@@ -336,6 +351,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 22);
+        assert_eq!(e.len(), 23);
     }
 }

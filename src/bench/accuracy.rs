@@ -146,6 +146,16 @@ pub const SWEEPS: &[Sweep] = &[
         why: "energy balance: conserved to f32 round-off at every resolution",
         quick: true,
     },
+    Sweep {
+        name: "recoil_layer_2d",
+        text: scene_text!("recoil_layer_2d"),
+        // The hot half of the layer: 5, 10, 20 rows.
+        length: 5.0e-5,
+        cells: &[5, 10, 20],
+        expected_order: None,
+        why: "momentum balance: the error is the surface delta's normalisation on the compressed surface rows, not a truncation order",
+        quick: false,
+    },
 ];
 
 const KERNELS: [KernelKind; 3] = [

@@ -128,3 +128,79 @@ impl Check for Laplace {
         }
     }
 }
+
+/// Recoil momentum balance: a layer with no walls and no gravity gains momentum
+/// only from the recoil pressure F22 (30) on its surfaces. Along the up axis it
+/// must gain −∫ p_v(T_s) A dt, T_s the mean temperature of the particles of the
+/// top surface (normal within 60° of up) and A the scene's `area`; integrated by
+/// the trapezoid rule over the samples.
+pub struct RecoilImpulse {
+    area: f64,
+    /// (time, momentum along up, p_v at the top surface's mean temperature).
+    samples: Vec<(f64, f64, f64)>,
+}
+
+impl RecoilImpulse {
+    pub fn new(c: &CheckDef) -> RecoilImpulse {
+        RecoilImpulse {
+            area: c.area.unwrap_or(f64::NAN),
+            samples: Vec::new(),
+        }
+    }
+}
+
+impl Check for RecoilImpulse {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let up = m.dim as usize - 1;
+        let (mut momentum, mut t_sum, mut t_n, mut pv_law) = (0.0, 0.0, 0usize, None);
+        for i in 0..st.active() {
+            let ph = &m.phases[st.phase[i] as usize];
+            if !ph.is_fluid() {
+                continue;
+            }
+            momentum += st.mass[i] as f64 * st.vel[i][up] as f64;
+            let s = st.surface.get(i).copied().unwrap_or([0.0; 4]);
+            if s[3] > 0.0 && s[up] > 0.5 {
+                t_sum += st.heat[i][1] as f64;
+                t_n += 1;
+                pv_law = pv_law.or(ph.thermal.and_then(|t| t.evaporation));
+            }
+        }
+        let pv = match (pv_law, t_n) {
+            (Some(e), n) if n > 0 => e.pressure(t_sum / n as f64),
+            _ => 0.0,
+        };
+        let t = st.sim.time as f64;
+        if self.samples.last().is_some_and(|s| s.0 == t) {
+            return;
+        }
+        self.samples.push((t, momentum, pv));
+    }
+
+    fn verdict(&mut self, _m: &Model, _st: &State) -> Verdict {
+        let metric = "relative error of the momentum gained against -integral p_v A dt".to_string();
+        let (Some(first), Some(last)) = (self.samples.first(), self.samples.last()) else {
+            return (metric, f64::NAN, Vec::new()).into();
+        };
+        let impulse: f64 = self
+            .samples
+            .windows(2)
+            .map(|w| -0.5 * (w[0].2 + w[1].2) * (w[1].0 - w[0].0) * self.area)
+            .sum();
+        let gained = last.1 - first.1;
+        let error = (gained - impulse).abs() / impulse.abs();
+        let details = vec![format!(
+            "  momentum gained {gained:.6e} kg m/s, -integral p_v A dt {impulse:.6e} (p_v {:.4e} -> {:.4e} Pa, t = {:.3e} -> {:.3e} s)",
+            first.2, last.2, first.0, last.0
+        )];
+        Verdict {
+            metric,
+            value: error,
+            details,
+            figures: vec![
+                ("momentum_gained".into(), gained),
+                ("recoil_impulse".into(), impulse),
+            ],
+        }
+    }
+}

@@ -210,7 +210,9 @@ pub(super) fn check_walls(
             .iter()
             .any(|p| p.name == name && p.kind == PhaseKind::Wall)
     };
-    let needs_walls = (0..dim as usize).any(|a| !periodic[a]);
+    // Walls go on every non-periodic side that is not open.
+    let open = open_side_flags(scene);
+    let needs_walls = (0..dim as usize).any(|a| !periodic[a] && open[a].iter().any(|o| !o));
     match &scene.domain.wall_phase {
         Some(w) if !is_wall(w) => {
             return Err(cx.err(

@@ -393,6 +393,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     };
     if let Some(c) = &scene.check {
         cx.positive("check.tolerance", c.tolerance)?;
+        if c.kind == crate::scene::CheckKind::RecoilImpulse {
+            cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;

@@ -144,8 +144,7 @@ pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
     let m = pr.phase(phase);
     let mut flux = 0.0f32;
     if m.evap_pressure > 0.0 {
-        let pv =
-            m.evap_pressure * pm_exp(-(m.evap_temperature * (1.0 / t - m.inv_boiling_temperature)));
+        let pv = vapour_pressure(pr, phase, t);
         let mdot = m.recondensation * pv * (m.vapor_constant / t).sqrt();
         flux +=
             mdot * (m.evap_latent_heat + m.liquid_heat_capacity * (t - m.evap_enthalpy_reference));
@@ -154,6 +153,15 @@ pub fn surface_loss(pr: &Params, phase: u32, t: f32, delta: f32) -> f32 {
         flux += m.emissivity_sb * (t * t * t * t - pr.surfaces.ambient_t4);
     }
     flux * delta / m.rho0
+}
+
+/// The vapour's pressure p_v(T) = C_p exp(−C_T (1/T − 1/T_v)), F22 (10): the
+/// evaporation loss and the recoil (cpu/surface_forces.rs) both use it. Twin of
+/// shaders/lib/vapour.wgsl.
+#[inline(always)]
+pub fn vapour_pressure(pr: &Params, phase: u32, t: f32) -> f32 {
+    let m = pr.phase(phase);
+    m.evap_pressure * pm_exp(-(m.evap_temperature * (1.0 / t - m.inv_boiling_temperature)))
 }
 
 /// Temperature and liquid fraction of the stored enthalpy h = h(T) − h(T_ref) for

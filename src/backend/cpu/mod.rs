@@ -9,7 +9,7 @@ mod integrate;
 mod interface;
 mod laser;
 mod neighbors;
-mod surface_tension;
+mod surface_forces;
 mod terms;
 mod timestep;
 mod wall;
@@ -84,8 +84,14 @@ impl CpuBackend {
     pub(crate) fn forces(&mut self) {
         forces::run(&self.params, &mut self.st, &self.grid, &self.list)
     }
-    pub(crate) fn surface_tension(&mut self) {
-        surface_tension::run(&self.params, &mut self.st, &self.grid)
+    pub(crate) fn surface_forces(&mut self) {
+        let f = self.pipeline.features;
+        if f.surface_tension {
+            surface_forces::surface_tension(&self.params, &mut self.st, &self.grid);
+        }
+        if f.recoil {
+            surface_forces::recoil(&self.params, &mut self.st);
+        }
     }
     pub(crate) fn laser(&mut self) {
         let pr = &self.params;

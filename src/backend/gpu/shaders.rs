@@ -22,7 +22,7 @@ use crate::params::Params;
 use std::collections::HashMap;
 
 /// Library files, in the order they are composed (each after what it uses).
-const LIBS: [(&str, &str); 7] = [
+const LIBS: [(&str, &str); 8] = [
     ("params", include_str!("../../../shaders/lib/params.wgsl")),
     (
         "bindings",
@@ -33,6 +33,7 @@ const LIBS: [(&str, &str); 7] = [
     ("kernel", include_str!("../../../shaders/lib/kernel.wgsl")),
     ("grid", include_str!("../../../shaders/lib/grid.wgsl")),
     ("phase", include_str!("../../../shaders/lib/phase.wgsl")),
+    ("vapour", include_str!("../../../shaders/lib/vapour.wgsl")),
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
@@ -47,8 +48,8 @@ pub const PASSES: [(&str, &str); 10] = [
     ("laser", include_str!("../../../shaders/laser.wgsl")),
     ("interface", include_str!("../../../shaders/interface.wgsl")),
     (
-        "surface_tension",
-        include_str!("../../../shaders/surface_tension.wgsl"),
+        "surface_forces",
+        include_str!("../../../shaders/surface_forces.wgsl"),
     ),
 ];
 

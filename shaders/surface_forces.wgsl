@@ -1,9 +1,10 @@
-// uses: params bindings consts kernel grid phase
+// uses: params bindings consts kernel grid phase math vapour
 // writes: acc surface
-// CSF surface tension with Marangoni stress, F22 (24)-(26), (8), (21), between the
-// liquid and the gas of P.tension, added to the acceleration the forces pass
-// wrote. Curvature kappa_i (Morris 2000, F22 (25)) goes to surface[n + i].y.
-// Twin of src/backend/cpu/surface_tension.rs (equations and choices there).
+// Forces at the interface, added to the acceleration the forces pass wrote:
+// surface_tension, CSF with Marangoni stress F22 (24)-(26), (8), (21) between the
+// liquid and the gas of P.tension (curvature kappa_i, Morris 2000 / F22 (25), to
+// surface[n + i].y); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
+// (equations and choices there).
 
 // F22 (21) f[T, T_m, T_m + dT_s]; 1 without a ramp.
 fn tension_ramp(t: f32) -> f32 {
@@ -112,5 +113,24 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     a.x = a.x + scale * (slope * tx - normal * s_i.x);
     a.y = a.y + scale * (slope * ty - normal * s_i.y);
     a.z = a.z + scale * (slope * tz - normal * s_i.z);
+    acc[i] = a;
+}
+
+// F22 (30) recoil: the vapour's pressure p_v(T) (F22 (10), the law of the
+// evaporation loss) pushes a liquid particle at the surface inward:
+// a -= p_v delta n / rho0 (V = m / rho0, the volume delta is normalised with).
+@compute @workgroup_size(64)
+fn recoil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let ph = phase[i];
+    if ((P.phases[ph].flags & PHASE_RECOIL) == 0u) { return; }
+    let s = surface[i];
+    if (s.w == 0.0) { return; }
+    let f = vapour_pressure(ph, heat[i].y) * s.w / P.phases[ph].rho0;
+    var a = acc[i];
+    a.x = a.x - f * s.x;
+    a.y = a.y - f * s.y;
+    a.z = a.z - f * s.z;
     acc[i] = a;
 }

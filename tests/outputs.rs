@@ -5,7 +5,6 @@ mod common;
 use common::{reader, scratch, spatter, text};
 use spatter::checkpoint;
 use spatter::output::{particle_fields, Values};
-use spatter::state::State;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -242,31 +241,9 @@ fn hard_kill_leaves_mcap_readable_to_its_last_chunk() {
 /// up the gate where it was.
 fn resume_is_bit_identical(backend: &str) {
     let dir = scratch(&format!("outputs_resume_{backend}"));
-    let sc = common::scene("dam_break_gate_2d");
-    let ck = |name: &str| dir.join(name);
-    let run = |extra: &[&str], ckdir: &Path| {
-        let mut args = vec!["run", "--backend", backend, "--steps"];
-        args.extend_from_slice(extra);
-        args.extend_from_slice(&["--checkpoint-every", "1e9", "--checkpoint-dir", s(ckdir)]);
-        let out = spatter(&args);
-        assert_eq!(out.status.code(), Some(0), "{:?}", text(&out));
-    };
-    run(&["200", &sc], &ck("straight"));
-    run(&["100", &sc], &ck("first"));
-    let half = dir.join("first/step_0000000100.ckpt");
-    run(&["100", "--resume", s(&half)], &ck("resumed"));
-    let a: State = newest_checkpoint(&ck("straight")).state;
-    let b: State = newest_checkpoint(&ck("resumed")).state;
-    assert_eq!(a.sim.step, 200);
-    assert_eq!(b.sim.step, 200);
-    for (fa, fb) in a.fields().iter().zip(b.fields().iter()) {
-        assert!(
-            fa.words == fb.words,
-            "{backend}: field {} differs after resume",
-            fa.name
-        );
-    }
-    assert_eq!(a.sim, b.sim);
+    let scene = common::scene("dam_break_gate_2d");
+    let (_, last) = common::assert_resume_bit_identical(&dir, &scene, backend, 100);
+    assert_eq!(last.sim.step, 200);
 }
 
 #[test]

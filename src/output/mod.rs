@@ -195,6 +195,60 @@ pub struct Diagnostics {
     /// Heat scenes only.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub heat: Option<HeatDiagnostics>,
+    /// Scenes with surface tension or recoil only.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<SurfaceDiagnostics>,
+}
+
+/// Surface-force diagnostics (issue 16): the liquid's surface as the interface
+/// pass sees it (Σ V δ over liquid particles with a normal: m² in 3D, m per metre
+/// of depth in 2D), its δ-weighted mean curvature (1/m; scenes with surface
+/// tension, 0 otherwise) and the power the recoil pressure does on the liquid,
+/// Σ V p_v δ (−n·u) (W; W/m in 2D; 0 without recoil).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SurfaceDiagnostics {
+    pub surface_area: f64,
+    pub mean_curvature: f64,
+    pub recoil_power: f64,
+}
+
+pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> {
+    let recoil = |ph: &crate::model::PhaseInfo| {
+        ph.thermal
+            .and_then(|t| t.evaporation)
+            .filter(|e| e.recoil && ph.kind == PhaseKind::Liquid)
+    };
+    let any_recoil = m.phases.iter().any(|p| recoil(p).is_some());
+    if st.surface.is_empty() || (m.surface_tension.is_none() && !any_recoil) {
+        return None;
+    }
+    let n = st.len();
+    let mut d = SurfaceDiagnostics {
+        surface_area: 0.0,
+        mean_curvature: 0.0,
+        recoil_power: 0.0,
+    };
+    for i in 0..st.active() {
+        let ph = &m.phases[st.phase[i] as usize];
+        let s = st.surface[i];
+        if ph.kind != PhaseKind::Liquid || s[3] == 0.0 {
+            continue;
+        }
+        let area = st.mass[i] as f64 / ph.rho0 * s[3] as f64;
+        d.surface_area += area;
+        d.mean_curvature += area * st.surface[n + i][1] as f64;
+        if let Some(e) = recoil(ph) {
+            let v = st.vel[i];
+            let un = (0..3).map(|a| s[a] as f64 * v[a] as f64).sum::<f64>();
+            d.recoil_power -= area * e.pressure(st.heat[i][1] as f64) * un;
+        }
+    }
+    if m.surface_tension.is_some() && d.surface_area > 0.0 {
+        d.mean_curvature /= d.surface_area;
+    } else {
+        d.mean_curvature = 0.0;
+    }
+    Some(d)
 }
 
 /// Heat diagnostics (issue 4). Melt pool: particles with liquid fraction ≥ ½
@@ -311,6 +365,7 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         wall_penetration_max_dx: 0.0,
         wall_penetration_count: 0,
         heat: heat_diagnostics(m, st),
+        surface: surface_diagnostics(m, st),
     };
     let leak = crate::watchdog::leakage(m, st);
     (d.wall_penetration_max_dx, d.wall_penetration_count) = (leak.deepest_dx, leak.beyond_half_dx);
@@ -387,6 +442,28 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
                      "removed", "removed_mass",
                      "wall_penetration_max_dx", "wall_penetration_count"]
     });
+    let any_recoil = m.phases.iter().any(|p| {
+        p.kind == PhaseKind::Liquid
+            && p.thermal
+                .and_then(|t| t.evaporation)
+                .is_some_and(|e| e.recoil)
+    });
+    if m.surface_tension.is_some() || (any_recoil && m.needs_interface()) {
+        let area = if m.dim == 2 {
+            "m per metre of depth"
+        } else {
+            "m^2"
+        };
+        schema["properties"]["surface_area"] = num(&format!(
+            "liquid surface, sum of V delta over liquid particles with a normal, {area}"
+        ));
+        schema["properties"]["mean_curvature"] = num(
+            "delta-weighted mean curvature of the liquid surface, 1/m (0 without surface tension)",
+        );
+        schema["properties"]["recoil_power"] = num(&format!(
+            "power of the recoil pressure on the liquid, W{per_depth}"
+        ));
+    }
     if m.is_thermal() {
         let unit = if m.dim == 2 {
             " per metre of depth"

@@ -127,15 +127,15 @@ fn the_stop_policy_ends_the_run_at_the_first_particle_out() {
             && stderr.contains("field x"),
         "{stderr}"
     );
-    let bad = spatter(&[
-        "validate",
-        &common::scene("jet_outflow_2d"),
-        "--set",
-        "domain.open_sides_policy=\"keep\"",
-    ]);
-    let (_, stderr) = text(&bad);
-    assert_eq!(bad.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("open_sides_policy"), "{stderr}");
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene("jet_outflow_2d"),
+            "--set",
+            "domain.open_sides_policy=\"keep\"",
+        ],
+        "open_sides_policy",
+    );
 }
 
 /// A shape's velocity is for phases that flow, with one component per axis.
@@ -271,10 +271,7 @@ fn barrier_input_is_checked() {
             "spring",
         ),
     ] {
-        let out = spatter(&["validate", &scene, "--set", set]);
-        let (_, stderr) = text(&out);
-        assert_eq!(out.status.code(), Some(2), "{set}: {stderr}");
-        assert!(stderr.contains(key), "{set}: {stderr}");
+        common::assert_input_error(&["validate", &scene, "--set", set], key);
     }
     let ok = spatter(&["validate", &scene]);
     let (stdout, _) = text(&ok);

@@ -98,10 +98,7 @@ fn bad_surface_tension_input_names_the_key() {
         ),
         ("surface_tension.smoothing=1.0", "smoothing"),
     ] {
-        let out = spatter(&["validate", &scene, "--set", set]);
-        let (_, stderr) = text(&out);
-        assert_eq!(out.status.code(), Some(2), "{set}: {stderr}");
-        assert!(stderr.contains(key), "{set}: {stderr}");
+        common::assert_input_error(&["validate", &scene, "--set", set], key);
     }
 }
 

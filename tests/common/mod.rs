@@ -115,3 +115,11 @@ pub fn assert_resume_bit_identical(
     assert_eq!(a.sim, b.sim);
     (at("first", half), a)
 }
+
+/// `spatter args…` exits 2 with a message naming `key` (bad input).
+pub fn assert_input_error(args: &[&str], key: &str) {
+    let out = spatter(args);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(stderr.contains(key), "{args:?}: no `{key}` in {stderr}");
+}

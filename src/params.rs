@@ -823,7 +823,7 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
         b.evap_enthalpy_reference = v.enthalpy_reference as f32;
         b.vapor_constant = v.vapor_constant as f32;
         b.recondensation = (0.82 * v.sticking) as f32;
-        if v.recoil && ph.kind == PhaseKind::Liquid {
+        if ph.recoil().is_some() {
             b.flags |= PHASE_RECOIL;
         }
     }

@@ -93,6 +93,12 @@ impl Thermal {
 }
 
 impl PhaseInfo {
+    /// The evaporation law of a liquid phase that takes the F22 (30) recoil.
+    pub fn recoil(&self) -> Option<Evaporation> {
+        self.thermal
+            .and_then(|t| t.evaporation)
+            .filter(|e| e.recoil && self.kind == PhaseKind::Liquid)
+    }
     /// Liquid or gas: moves with the flow.
     pub fn is_fluid(&self) -> bool {
         matches!(self.kind, PhaseKind::Liquid | PhaseKind::Gas)

@@ -213,12 +213,7 @@ pub struct SurfaceDiagnostics {
 }
 
 pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> {
-    let recoil = |ph: &crate::model::PhaseInfo| {
-        ph.thermal
-            .and_then(|t| t.evaporation)
-            .filter(|e| e.recoil && ph.kind == PhaseKind::Liquid)
-    };
-    let any_recoil = m.phases.iter().any(|p| recoil(p).is_some());
+    let any_recoil = m.phases.iter().any(|p| p.recoil().is_some());
     if st.surface.is_empty() || (m.surface_tension.is_none() && !any_recoil) {
         return None;
     }
@@ -237,7 +232,7 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
         let area = st.mass[i] as f64 / ph.rho0 * s[3] as f64;
         d.surface_area += area;
         d.mean_curvature += area * st.surface[n + i][1] as f64;
-        if let Some(e) = recoil(ph) {
+        if let Some(e) = ph.recoil() {
             let v = st.vel[i];
             let un = (0..3).map(|a| s[a] as f64 * v[a] as f64).sum::<f64>();
             d.recoil_power -= area * e.pressure(st.heat[i][1] as f64) * un;
@@ -442,12 +437,7 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
                      "removed", "removed_mass",
                      "wall_penetration_max_dx", "wall_penetration_count"]
     });
-    let any_recoil = m.phases.iter().any(|p| {
-        p.kind == PhaseKind::Liquid
-            && p.thermal
-                .and_then(|t| t.evaporation)
-                .is_some_and(|e| e.recoil)
-    });
+    let any_recoil = m.phases.iter().any(|p| p.recoil().is_some());
     if m.surface_tension.is_some() || (any_recoil && m.needs_interface()) {
         let area = if m.dim == 2 {
             "m per metre of depth"

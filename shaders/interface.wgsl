@@ -14,6 +14,11 @@ fn gets_gas_interface(ph: u32) -> bool {
     return conducts(ph) || (flows && !is_wall(ph));
 }
 
+// Twin of Params::gets_free_surface_normal.
+fn gets_free_surface_normal(ph: u32) -> bool {
+    return conducts(ph) || ((P.sizes.flags & FLAG_SURFACE_TENSION) != 0u && !is_wall(ph));
+}
+
 fn volume(j: u32) -> f32 {
     return mass[j] / P.phases[phase[j]].rho0;
 }
@@ -91,7 +96,7 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let ph = phase[i];
-    if (!condensed(ph) || !conducts(ph)) {
+    if (!condensed(ph) || !gets_free_surface_normal(ph)) {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }

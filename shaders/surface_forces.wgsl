@@ -3,7 +3,9 @@
 // Forces at the interface, added to the acceleration the forces pass wrote:
 // surface_tension, CSF with Marangoni stress F22 (24)-(26), (8), (21) between the
 // liquid and the gas of P.tension (curvature kappa_i, Morris 2000 / F22 (25), to
-// surface[n + i].y); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
+// surface[n + i].y), or in the free-surface form (FLAG_FREE_SURFACE_TENSION, R18
+// 3.1.1-3.1.2) its raw curvature (surface_tension) then the smoothed curvature and
+// force (tension_smooth); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
 // (equations and choices there).
 
 // F22 (21) f[T, T_m, T_m + dT_s]; 1 without a ramp.
@@ -45,6 +47,10 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     let i = thread_index(gid, nwg);
     if (i >= active_particles()) { return; }
     let n = P.sizes.n_particles;
+    if ((P.sizes.flags & FLAG_FREE_SURFACE_TENSION) != 0u) {
+        free_surface_curvature(i);
+        return;
+    }
     let ph_i = phase[i];
     if (!in_tension_pair(ph_i)) { return; }
     let liquid_i = ph_i == P.tension.liquid;
@@ -95,6 +101,15 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     }
     surface[n + i].y = kappa;
     if (!liquid_i) { return; }
+    var a = acc[i];
+    a = vec4<f32>(a.xyz + tension_force(s_i, t_i, kappa, gt, rho[i]), a.w);
+    acc[i] = a;
+}
+
+// F22 (24) per unit mass on a liquid particle with normal and delta s_i,
+// temperature t_i, curvature kappa and temperature gradient gt:
+// f[T_i] delta (alpha' grad_t T - alpha kappa n) / rho, F22 (8) (alpha' = 0 where clipped).
+fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32) -> vec3<f32> {
     let raw = P.tension.alpha0 + P.tension.alpha_slope * (t_i - P.tension.t_ref);
     var alpha = raw;
     var slope = P.tension.alpha_slope;
@@ -107,12 +122,105 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     let tx = gt.x - nt * s_i.x;
     let ty = gt.y - nt * s_i.y;
     let tz = gt.z - nt * s_i.z;
-    let scale = tension_ramp(t_i) * delta / rho[i];
+    let scale = tension_ramp(t_i) * delta / rho_i;
     let normal = alpha * kappa;
+    return vec3<f32>(
+        scale * (slope * tx - normal * s_i.x),
+        scale * (slope * ty - normal * s_i.y),
+        scale * (slope * tz - normal * s_i.z),
+    );
+}
+
+// Free-surface form, R18 (3.28)-(3.29): raw Morris curvature over the liquid's
+// particles with a normal, weights V delta (V = m / rho0), capped at
+// |kappa| <= 1/support; to
+// surface[n + i].z (the Shepard pass zeroed it for everyone else).
+fn free_surface_curvature(i: u32) {
+    let n = P.sizes.n_particles;
+    let liquid = P.tension.liquid;
+    let s_i = surface[i];
+    if (phase[i] != liquid || s_i.w == 0.0) { return; }
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var num = 0.0;
+    var den = 0.0;
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kernel.support2) {
+            let s_j = surface[j];
+            if (phase[j] == liquid && s_j.w != 0.0) {
+                let r = sqrt(r2);
+                let fv = tension_ramp(tension_temperature(j)) * (mass[j] / P.phases[liquid].rho0) * s_j.w;
+                den = den + fv * kernel_w(r);
+                if (r2 > 0.0) {
+                    let dn = (s_i.x - s_j.x) * d.x + (s_i.y - s_j.y) * d.y + (s_i.z - s_j.z) * d.z;
+                    num = num + fv * (dn / r) * kernel_dw(r);
+                }
+            }
+        }
+    }
+    var kappa = 0.0;
+    if (den > 0.0) {
+        kappa = -(num / den);
+    }
+    surface[n + i].z = min(max(kappa, -P.tension.kappa_max), P.tension.kappa_max);
+}
+
+// Free-surface form, second dispatch: the curvature smoothed, R18 (3.30), the
+// Shepard-corrected temperature gradient, R18 (3.34), and the force with rho0.
+@compute @workgroup_size(64)
+fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let n = P.sizes.n_particles;
+    let liquid = P.tension.liquid;
+    let s_i = surface[i];
+    if (phase[i] != liquid || s_i.w == 0.0) { return; }
+    let heated = (P.sizes.flags & FLAG_HEAT) != 0u;
+    let t_i = tension_temperature(i);
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var num = 0.0;
+    var den = 0.0;
+    var shepard = 0.0;
+    var gt = vec3<f32>(0.0);
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kernel.support2) {
+            let ph_j = phase[j];
+            let r = sqrt(r2);
+            let w = kernel_w(r);
+            let v_j = mass[j] / P.phases[ph_j].rho0;
+            if (ph_j == liquid && surface[j].w != 0.0) {
+                let fv = tension_ramp(tension_temperature(j)) * v_j * surface[j].w;
+                den = den + fv * w;
+                num = num + fv * surface[n + j].z * w;
+            }
+            if (heated && has_temperature(ph_j)) {
+                shepard = shepard + v_j * w;
+                if (r2 > 0.0) {
+                    let g = v_j * (heat[j].y - t_i) * kernel_dw(r) / r;
+                    gt.x = gt.x + g * d.x;
+                    gt.y = gt.y + g * d.y;
+                    gt.z = gt.z + g * d.z;
+                }
+            }
+        }
+    }
+    var kappa = 0.0;
+    if (den > 0.0) {
+        kappa = num / den;
+    }
+    if (shepard > 0.0) {
+        gt = vec3<f32>(gt.x / shepard, gt.y / shepard, gt.z / shepard);
+    }
+    surface[n + i].y = kappa;
     var a = acc[i];
-    a.x = a.x + scale * (slope * tx - normal * s_i.x);
-    a.y = a.y + scale * (slope * ty - normal * s_i.y);
-    a.z = a.z + scale * (slope * tz - normal * s_i.z);
+    a = vec4<f32>(a.xyz + tension_force(s_i, t_i, kappa, gt, P.phases[liquid].rho0), a.w);
     acc[i] = a;
 }
 

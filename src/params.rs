@@ -31,6 +31,12 @@ pub const FLAG_GAS_INTERFACE: u32 = 128;
 pub const FLAG_SURFACE_TENSION: u32 = 256;
 /// Some phase takes the F22 (30) recoil pressure (PHASE_RECOIL).
 pub const FLAG_RECOIL: u32 = 512;
+/// Surface tension in the free-surface form (R18 §3.1.1–3.1.2, no gas particles):
+/// the curvature is capped and smoothed (`tension_smooth`); `tension.gas` is
+/// `NO_PHASE`.
+pub const FLAG_FREE_SURFACE_TENSION: u32 = 1024;
+/// A phase index that names no phase (`tension.gas` of the free-surface form).
+pub const NO_PHASE: u32 = u32::MAX;
 
 /// `Phase::kind`.
 pub const KIND_LIQUID: u32 = 0;
@@ -171,8 +177,10 @@ gpu_struct! {
         pub t_melt: f32,
         pub inv_ramp_width: f32,
         pub liquid: u32,
+        /// NO_PHASE in the free-surface form.
         pub gas: u32,
-        pub pad0: u32,
+        /// Free-surface form: |κ| ≤ 1/support (R18's cap 1/(2h) of Wendland); 0 otherwise.
+        pub kappa_max: f32,
         pub pad3: u32,
         pub pad1: u32,
         pub pad2: u32,
@@ -494,7 +502,14 @@ impl Params {
                 t.inv_ramp_width = (1.0 / width) as f32;
             }
             t.liquid = s.liquid as u32;
-            t.gas = s.gas as u32;
+            match s.gas {
+                Some(g) => t.gas = g as u32,
+                None => {
+                    p.sizes.flags |= FLAG_FREE_SURFACE_TENSION;
+                    t.gas = NO_PHASE;
+                    t.kappa_max = (1.0 / m.support) as f32;
+                }
+            }
         }
         p.flow.wall_weight_floor = (WALL_WEIGHT_FLOOR * crate::kernel::w(&p, 0.0) as f64) as f32;
         p
@@ -537,6 +552,11 @@ impl Params {
         self.conducts(phase)
             || ((self.flow.interface_viscosity > 0.0 || self.flag(FLAG_SURFACE_TENSION))
                 && !self.is_wall(phase))
+    }
+    /// Condensed particles the free-surface interface pass gives a normal and δ:
+    /// conducting ones (surface fluxes) and, with surface tension, the fluid ones.
+    pub fn gets_free_surface_normal(&self, phase: u32) -> bool {
+        self.conducts(phase) || (self.flag(FLAG_SURFACE_TENSION) && !self.is_wall(phase))
     }
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phases[phase as usize].flags

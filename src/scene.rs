@@ -103,14 +103,18 @@ pub struct SceneFile {
 }
 
 /// `[surface_tension]`: CSF surface tension with Marangoni, F22 (24)–(26), (8),
-/// between one liquid phase and one gas phase (F22's form, with gas particles).
+/// between one liquid phase and one gas phase (F22's form, with gas particles),
+/// or at the free surface of a liquid in a scene without gas particles (R18
+/// §3.1.1–3.1.2: Shepard-corrected colour gradient, curvature capped at 1/support
+/// and smoothed); `gas` chooses.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceTensionDef {
     /// The liquid phase.
     pub liquid: String,
-    /// The gas phase around it.
-    pub gas: String,
+    /// The gas phase around it (F22's form). Absent: the free-surface form, for
+    /// scenes without gas particles.
+    pub gas: Option<String>,
     /// α0 (N/m): the coefficient at `reference_temperature` (or everywhere when
     /// `temperature_coefficient` is 0).
     pub coefficient: f64,

@@ -295,3 +295,41 @@ fn surface_tension_with_temperature_200_steps() {
     std::fs::write(&path, text).unwrap();
     assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
 }
+
+/// Issue 16: surface tension in the free-surface form (R18, no gas particles):
+/// capped curvature, its smoothing, the force with ρ0; 200 steps of the free disc.
+#[test]
+fn free_surface_tension_static_drop_200_steps() {
+    assert_bit_identical("laplace_free_disc_2d", &[], 200);
+}
+
+/// The free-surface form with temperature: the drop at 1716 K sits on a floor
+/// held at 1500 K (Dirichlet wall), so its surface cools along its length (the
+/// Shepard-corrected ∇T with wall neighbours, the Marangoni term), crosses the
+/// α_min clip and enters the F22 (21) ramp above the solidus.
+#[test]
+fn free_surface_tension_with_temperature_200_steps() {
+    let full = std::fs::read_to_string(common::scene("laplace_free_disc_2d")).unwrap();
+    let text = full[..full.find("[check]").unwrap()]
+        .replace(
+            "open_sides = [\"x_min\", \"x_max\", \"y_min\", \"y_max\"]",
+            "open_sides = [\"x_min\", \"x_max\", \"y_max\"]\nwall_phase = \"floor\"",
+        )
+        .replace(
+            "reference_pressure = 1000.0     # c = 1 m/s: sigma / R = 5 Pa is 0.5% of p0",
+            "reference_pressure = 1000.0\nconductivity = 20.0\nheat_capacity = 500.0\nsolidus = 1690.0\nliquidus = 1700.0\nlatent_heat = 1.0e4",
+        )
+        .replace(
+            "kind = \"liquid\"\nmaterial = \"liquid\"",
+            "kind = \"liquid\"\nmaterial = \"liquid\"\ntemperature = 1716.0\n\n[phases.floor]\nkind = \"wall\"\nmaterial = \"liquid\"\ntemperature = 1500.0",
+        )
+        .replace("center = [0.04, 0.04]", "center = [0.04, 0.021]")
+        .replace(
+            "coefficient = 0.1               # N/m",
+            "coefficient = 0.1\ntemperature_coefficient = -2.0e-3\nreference_temperature = 1700.0\nminimum = 0.07\nmelting_width = 20.0",
+        );
+    let dir = common::scratch("bitmatch_free_tension");
+    let path = dir.join("hot_sessile_drop.toml");
+    std::fs::write(&path, text).unwrap();
+    assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
+}

@@ -4,7 +4,11 @@ mod common;
 use common::{spatter, text};
 
 fn run_laplace(sets: &[&str]) -> (f64, String) {
-    let scene = common::scene("laplace_disc_2d");
+    run_laplace_scene("laplace_disc_2d", sets)
+}
+
+fn run_laplace_scene(name: &str, sets: &[&str]) -> (f64, String) {
+    let scene = common::scene(name);
     let mut args = vec!["run", scene.as_str(), "--backend", "cpu"];
     for s in sets {
         args.extend_from_slice(&["--set", s]);
@@ -51,13 +55,57 @@ fn laplace_pressure_within_3_percent_at_20_dx() {
 fn laplace_pressure_at_10_dx_as_measured() {
     let (error, out) = run_laplace(&["dx=2e-3"]);
     assert!(error <= 0.15, "{out}");
-    let ca: f64 = out
-        .split("capillary number eta |u| / sigma = ")
+    assert!(capillary_number(&out) < 0.1, "{out}");
+}
+
+fn capillary_number(out: &str) -> f64 {
+    out.split("capillary number eta |u| / sigma = ")
         .nth(1)
         .and_then(|v| v.split_whitespace().next())
         .and_then(|v| v.parse().ok())
-        .expect("capillary number");
-    assert!(ca < 0.1, "{out}");
+        .expect("capillary number")
+}
+
+/// The issue's reference for the free-surface form (R18 §3.1.1–3.1.2, no gas):
+/// Δp within 5% of σ/R at R = 20Δx. Not met, and not converging: +211%, +285%,
+/// +764% at R = 10, 20, 40Δx. Cause (measured at 10Δx): with summation density
+/// the surface row's density is short (737 kg/m³ at t = 0), so the pressure
+/// floor leaves it at p = 0 and nothing resists the CSF force tangentially: the
+/// row compacts from 56 particles at 1.00Δx to 92 at 0.49Δx (density 1016) and
+/// buckles at the particle scale, and the curvature of the buckled skin (mean
+/// κR 1.48 → 3.30) sets the pressure. A stiffer EOS (p0 × 10) changes nothing
+/// (2.08 against 2.11): the skin is unresisted until it reaches ρ0. R18 integrates
+/// the continuity equation with δ-SPH diffusion (R18 (3.14)), which the
+/// δ-SPH formulation brings; R18's own Young–Laplace run measured 6 against the
+/// 2D σ/R = 10 (−40%; PAPERS-EXTRACT §7.2 row 14). See the note on issue 16.
+#[test]
+#[ignore = "free-surface Laplace +285% at R = 20 dx (issue asks 5%): the surface row compacts under summation density with a pressure floor; needs continuity density (delta-SPH); see the note on issue 16"]
+fn free_surface_laplace_within_5_percent_at_20_dx() {
+    let (error, out) = run_laplace_scene("laplace_free_disc_2d", &[]);
+    assert!(error <= 0.05, "{out}");
+}
+
+/// What the free-surface form gives today at R = 10Δx (2 s): +211% measured; the
+/// bound 250% only keeps the gap from growing unseen. The drop stays together
+/// and nearly still: capillary number 2.0e-2 measured, bound 0.1.
+#[test]
+fn free_surface_laplace_at_10_dx_as_measured() {
+    let (error, out) = run_laplace_scene("laplace_free_disc_2d", &["dx=2e-3"]);
+    assert!(error <= 2.5, "{out}");
+    assert!(out.contains("no particle left the domain"), "{out}");
+    assert!(capillary_number(&out) < 0.1, "{out}");
+}
+
+/// A scene with gas particles must name its gas: the free-surface form is for
+/// scenes without them.
+#[test]
+fn surface_tension_without_gas_key_in_a_gas_scene_is_refused() {
+    let text = std::fs::read_to_string(common::scene("laplace_disc_2d"))
+        .unwrap()
+        .replace("gas = \"gas\"\n", "");
+    let path = common::scratch("tension_no_gas_key").join("drop.toml");
+    std::fs::write(&path, text).unwrap();
+    common::assert_input_error(&["validate", path.to_str().unwrap()], "surface_tension.gas");
 }
 
 /// `validate` lists the pass and the capillary limit for a scene with surface

@@ -61,8 +61,8 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     t_melt: f32,             // ramp f[T, T_m, T_m + dT_s]
     inv_ramp_width: f32,     // 1/dT_s (0: no ramp)
     liquid: u32,
-    gas: u32,
-    pad0: u32,
+    gas: u32,                // NO_PHASE in the free-surface form
+    kappa_max: f32,          // free-surface form: |kappa| <= 1/support
     pad3: u32,
     pad1: u32,
     pad2: u32,
@@ -207,6 +207,8 @@ const FLAG_INTERFACE: u32 = 64u;
 const FLAG_GAS_INTERFACE: u32 = 128u;
 const FLAG_SURFACE_TENSION: u32 = 256u;
 const FLAG_RECOIL: u32 = 512u;
+const FLAG_FREE_SURFACE_TENSION: u32 = 1024u;
+const NO_PHASE: u32 = 4294967295u;
 const KIND_LIQUID: u32 = 0u;
 const KIND_GAS: u32 = 1u;
 const KIND_WALL: u32 = 2u;

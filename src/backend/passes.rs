@@ -5,8 +5,8 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL, FLAG_SURFACE_TENSION,
-    LASER_BEER_LAMBERT, LASER_SURFACE,
+    Params, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL,
+    FLAG_SURFACE_TENSION, LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -91,6 +91,8 @@ pub struct Features {
     pub laser_surface: bool,
     /// F22 (24)–(26) surface tension.
     pub surface_tension: bool,
+    /// Its free-surface form (R18): the curvature is smoothed in a second dispatch.
+    pub free_surface_tension: bool,
     /// F22 (30) recoil pressure.
     pub recoil: bool,
 }
@@ -110,6 +112,7 @@ impl Features {
             laser_bins: params.laser.model == LASER_BEER_LAMBERT,
             laser_surface: params.laser.model == LASER_SURFACE,
             surface_tension: params.flag(FLAG_SURFACE_TENSION),
+            free_surface_tension: params.flag(FLAG_FREE_SURFACE_TENSION),
             recoil: params.flag(FLAG_RECOIL),
         }
     }
@@ -228,6 +231,11 @@ pub const STAGES: [StageDef; 12] = [
                 entry: "surface_tension",
                 work: Work::Particles,
                 when: |f| f.surface_tension,
+            },
+            Dispatch {
+                entry: "tension_smooth",
+                work: Work::Particles,
+                when: |f| f.free_surface_tension,
             },
             Dispatch {
                 entry: "recoil",

@@ -100,6 +100,16 @@ pub const SWEEPS: &[Sweep] = &[
         quick: false,
     },
     Sweep {
+        name: "laplace_free_disc_2d",
+        text: scene_text!("laplace_free_disc_2d"),
+        // The disc's radius: R = 10, 20, 40 Δx.
+        length: 0.02,
+        cells: &[10, 20, 40],
+        expected_order: Some(1.0),
+        why: "R18's free-surface CSF would be 1st order like the gas form; today the surface row compacts under summation density and the error grows",
+        quick: false,
+    },
+    Sweep {
         name: "conduction_1d",
         text: scene_text!("conduction_1d"),
         length: 0.01,

@@ -7,7 +7,8 @@ use crate::state::State;
 
 /// Laplace pressure of a drop at rest: the mean pressure of the liquid more than
 /// one kernel support inside the surface, minus that of the gas more than one
-/// support outside it, against σ/R (2D) or 2σ/R (3D). The jump is averaged over
+/// support outside it (0, the ambient pressure of a free surface, in the
+/// free-surface form without gas particles), against σ/R (2D) or 2σ/R (3D). The jump is averaged over
 /// the samples of the run's second half (the drop oscillates about rest and
 /// settles; one sample carries the acoustic noise). The largest speed of those
 /// samples (spurious currents) is reported, and as a capillary number η|u|/σ.
@@ -65,12 +66,18 @@ impl Check for Laplace {
                 outside = (outside.0 + p.p, outside.1 + 1);
             }
         }
-        if inside.1 == 0 || outside.1 == 0 {
+        let free_surface = m.surface_tension.as_ref().is_some_and(|s| s.gas.is_none());
+        if inside.1 == 0 || (outside.1 == 0 && !free_surface) {
             return;
         }
+        let ambient = if free_surface {
+            0.0
+        } else {
+            outside.0 / outside.1 as f64
+        };
         self.samples.push(Sample {
             time: st.sim.time as f64,
-            jump: inside.0 / inside.1 as f64 - outside.0 / outside.1 as f64,
+            jump: inside.0 / inside.1 as f64 - ambient,
             max_speed,
         });
     }

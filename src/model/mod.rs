@@ -351,7 +351,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             None => f64::INFINITY,
         },
         capillary: surface_tension.as_ref().map_or(f64::INFINITY, |s| {
-            let rho = phases[s.liquid].rho0.min(phases[s.gas].rho0);
+            let rho = s.gas.map_or(phases[s.liquid].rho0, |g| {
+                phases[s.liquid].rho0.min(phases[g].rho0)
+            });
             0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(&phases)))
                 .sqrt()
         }),

@@ -1,5 +1,6 @@
 //! Surface tension between a liquid and a gas phase, F22 (24)–(26) with the law
-//! F22 (8) and the regularisation F22 (21), from `[surface_tension]`.
+//! F22 (8) and the regularisation F22 (21), or at a liquid's free surface in a
+//! scene without gas particles (R18 §3.1.1–3.1.2), from `[surface_tension]`.
 
 use super::*;
 
@@ -9,7 +10,8 @@ use super::*;
 pub struct SurfaceTension {
     /// Phase indices.
     pub liquid: usize,
-    pub gas: usize,
+    /// The gas phase of F22's form; None: the free-surface form (no gas particles).
+    pub gas: Option<usize>,
     pub coefficient: f64,
     pub slope: f64,
     pub reference_temperature: f64,
@@ -60,7 +62,18 @@ pub(super) fn surface_tension(
         Ok(i)
     };
     let liquid = phase("surface_tension.liquid", &d.liquid, PhaseKind::Liquid)?;
-    let gas = phase("surface_tension.gas", &d.gas, PhaseKind::Gas)?;
+    let gas = match &d.gas {
+        Some(name) => Some(phase("surface_tension.gas", name, PhaseKind::Gas)?),
+        None => {
+            if let Some(g) = phases.iter().find(|p| p.kind == PhaseKind::Gas) {
+                return Err(cx.err(
+                    "surface_tension.gas",
+                    format!("missing: the scene has the gas phase `{}`; name it (F22's form), or drop the gas particles for the free-surface form", g.name),
+                ));
+            }
+            None
+        }
+    };
     let coefficient = cx.positive("surface_tension.coefficient", d.coefficient)?;
     if !(d.temperature_coefficient.is_finite() && d.temperature_coefficient <= 0.0) {
         return Err(cx.err(

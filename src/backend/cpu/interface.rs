@@ -8,7 +8,9 @@
 //!   and δ = 0 (F22 (20)'s tolerance: such particles are not at the interface, and
 //!   surface fluxes must not reach them),
 //! κ the planar-lattice normalisation (params::surface_delta_integral),
-//! over condensed neighbours j, V = m/ρ0. Stored for liquid and solid particles.
+//! over condensed neighbours j, V = m/ρ0. Stored for conducting liquid and solid
+//! particles, and for liquid ones with surface tension
+//! (`Params::gets_free_surface_normal`).
 //!
 //! With gas particles in the scene the interface is the condensed–gas one of
 //! F22 (19)–(20) instead, for every conducting particle i (every fluid particle
@@ -57,7 +59,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
         .map(|i| {
-            if !condensed(pr, phase[i]) || !pr.conducts(phase[i]) {
+            if !condensed(pr, phase[i]) || !pr.gets_free_surface_normal(phase[i]) {
                 return [0.0; 4];
             }
             let mut g = [0.0f32; 3];

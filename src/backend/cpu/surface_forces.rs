@@ -110,28 +110,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
             if !liquid_i {
                 return Some((None, kappa));
             }
-            let t = &pr.tension;
-            let raw = t.alpha0 + t.alpha_slope * (t_i - t.t_ref);
-            let (alpha, slope) = if raw <= t.alpha_min {
-                (t.alpha_min, 0.0)
-            } else {
-                (raw, t.alpha_slope)
-            };
-            let delta = n_i[3];
-            let nt = n_i[0] * gt[0] + n_i[1] * gt[1] + n_i[2] * gt[2];
-            let tan = [
-                gt[0] - nt * n_i[0],
-                gt[1] - nt * n_i[1],
-                gt[2] - nt * n_i[2],
-            ];
-            let scale = ramp(pr, t_i) * delta / s.rho[i];
-            let normal = alpha * kappa;
-            let a = [
-                scale * (slope * tan[0] - normal * n_i[0]),
-                scale * (slope * tan[1] - normal * n_i[1]),
-                scale * (slope * tan[2] - normal * n_i[2]),
-            ];
-            Some((Some(a), kappa))
+            Some((Some(force(pr, n_i, t_i, kappa, gt, s.rho[i])), kappa))
         })
         .collect();
     for (i, o) in out.into_iter().enumerate() {
@@ -143,6 +122,151 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
         }
         st.surface[n + i][1] = kappa;
     }
+}
+
+/// R18 (3.28)–(3.29), the free-surface form's raw curvature (first of its two
+/// dispatches): Morris' κ_i = −Σ_j f_j V_j δ_j (n_i − n_j)·e_ij W'_ij /
+/// Σ_j f_j V_j δ_j W_ij over the liquid's particles j with a normal (j = i in the
+/// denominator), V = m/ρ0 (the interface pass's volume: summation density is short
+/// at a free surface), f = F22 (21)'s ramp as in the gas form; capped at
+/// |κ| ≤ 1/support (R18's κ_max = 1/(2h) for Wendland, whose support is 2h; both
+/// signs: a concave corner is as unreliable as a convex one). To surface[n + i].z.
+/// The weight δ_j (the surface measure: Σ V δ g ≈ ∫ g dA) is ours, not R18's: the
+/// Shepard-corrected gradient also gives a normal to the row under the surface,
+/// whose gradient barely passes the threshold and whose direction is noise; with
+/// R18's 0/1 mask those rows reached the cap within 0.01 s on the free disc and
+/// their κ spread into the surface row through the smoothing (Laplace jump at
+/// R = 20Δx +459% with the mask, +285% with δ; +206% and +211% at 10Δx: neither
+/// is right, see laplace_free_disc_2d and the note on issue 16).
+pub fn free_surface_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
+    let (n, active) = (st.len(), st.active());
+    let heated = pr.flag(FLAG_HEAT);
+    let s: &State = st;
+    let liquid = pr.tension.liquid;
+    let weight = |j: usize| {
+        let t = if heated { s.heat[j][1] } else { 0.0 };
+        ramp(pr, t) * (s.mass[j] / pr.phase(liquid).rho0) * s.surface[j][3]
+    };
+    let kmax = pr.tension.kappa_max;
+    let kappa: Vec<f32> = (0..active)
+        .into_par_iter()
+        .map(|i| {
+            let n_i = s.surface[i];
+            if s.phase[i] != liquid || n_i[3] == 0.0 {
+                return 0.0;
+            }
+            let (mut num, mut den) = (0.0f32, 0.0f32);
+            for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+                let n_j = s.surface[j];
+                if s.phase[j] != liquid || n_j[3] == 0.0 {
+                    return;
+                }
+                let r = r2.sqrt();
+                let fv = weight(j);
+                den += fv * kernel::w(pr, r);
+                if r2 > 0.0 {
+                    let dn = (n_i[0] - n_j[0]) * d[0]
+                        + (n_i[1] - n_j[1]) * d[1]
+                        + (n_i[2] - n_j[2]) * d[2];
+                    num += fv * (dn / r) * kernel::dw(pr, r);
+                }
+            });
+            let k = if den > 0.0 { -(num / den) } else { 0.0 };
+            k.max(-kmax).min(kmax)
+        })
+        .collect();
+    for (i, k) in kappa.into_iter().enumerate() {
+        st.surface[n + i][2] = k;
+    }
+}
+
+/// The free-surface form's force (second dispatch): the raw curvature smoothed,
+/// R18 (3.30), κ_i = Σ_j f_j V_j δ_j κ_j W_ij / Σ_j f_j V_j δ_j W_ij over the same
+/// neighbours and weights (to surface[n + i].y); the temperature gradient Shepard-corrected,
+/// R18 (3.34) as PAPERS-EXTRACT §5.3 reads it, ∇T_i = Σ_j V_j (T_j − T_i) W'_ij e_ij
+/// / Σ_j V_j W_ij over the neighbours with a temperature (the missing outside
+/// would bias the plain sum at the surface); then F22 (24)'s force, as in the gas
+/// form, a_i = f[T_i] δ_i (α'_i ∇_t T_i − α_i κ_i n_i)/ρ0 (R18 (3.31), (3.35)).
+pub fn free_surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
+    let (n, active) = (st.len(), st.active());
+    let heated = pr.flag(FLAG_HEAT);
+    let s: &State = st;
+    let liquid = pr.tension.liquid;
+    let rho0 = pr.phase(liquid).rho0;
+    let temperature = |j: usize| if heated { s.heat[j][1] } else { 0.0 };
+    let has_temperature =
+        |ph: u32| pr.conducts(ph) || (heated && pr.heat_flags(ph) & HEAT_DIRICHLET != 0);
+    let volume = |j: usize| s.mass[j] / pr.phase(s.phase[j]).rho0;
+    let out: Vec<Option<([f32; 3], f32)>> = (0..active)
+        .into_par_iter()
+        .map(|i| {
+            let n_i = s.surface[i];
+            if s.phase[i] != liquid || n_i[3] == 0.0 {
+                return None;
+            }
+            let t_i = temperature(i);
+            let (mut num, mut den, mut shepard) = (0.0f32, 0.0f32, 0.0f32);
+            let mut gt = [0.0f32; 3];
+            for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+                let ph_j = s.phase[j];
+                let r = r2.sqrt();
+                let w = kernel::w(pr, r);
+                if ph_j == liquid && s.surface[j][3] != 0.0 {
+                    let fv = ramp(pr, temperature(j)) * volume(j) * s.surface[j][3];
+                    den += fv * w;
+                    num += fv * s.surface[n + j][2] * w;
+                }
+                if heated && has_temperature(ph_j) {
+                    shepard += volume(j) * w;
+                    if r2 > 0.0 {
+                        let g = volume(j) * (s.heat[j][1] - t_i) * kernel::dw(pr, r) / r;
+                        for a in 0..3 {
+                            gt[a] += g * d[a];
+                        }
+                    }
+                }
+            });
+            let kappa = if den > 0.0 { num / den } else { 0.0 };
+            if shepard > 0.0 {
+                gt = [gt[0] / shepard, gt[1] / shepard, gt[2] / shepard];
+            }
+            Some((force(pr, n_i, t_i, kappa, gt, rho0), kappa))
+        })
+        .collect();
+    for (i, o) in out.into_iter().enumerate() {
+        let Some((a, kappa)) = o else { continue };
+        for c in 0..3 {
+            st.acc[i][c] += a[c];
+        }
+        st.surface[n + i][1] = kappa;
+    }
+}
+
+/// F22 (24) per unit mass on a liquid particle with normal and δ `n_i`,
+/// temperature `t_i`, curvature κ and temperature gradient ∇T:
+/// f[T_i] δ (α' ∇_t T − α κ n)/ρ, α(T) and α' from F22 (8) (α' = 0 where clipped).
+#[inline(always)]
+fn force(pr: &Params, n_i: [f32; 4], t_i: f32, kappa: f32, gt: [f32; 3], rho: f32) -> [f32; 3] {
+    let t = &pr.tension;
+    let raw = t.alpha0 + t.alpha_slope * (t_i - t.t_ref);
+    let (alpha, slope) = if raw <= t.alpha_min {
+        (t.alpha_min, 0.0)
+    } else {
+        (raw, t.alpha_slope)
+    };
+    let nt = n_i[0] * gt[0] + n_i[1] * gt[1] + n_i[2] * gt[2];
+    let tan = [
+        gt[0] - nt * n_i[0],
+        gt[1] - nt * n_i[1],
+        gt[2] - nt * n_i[2],
+    ];
+    let scale = ramp(pr, t_i) * n_i[3] / rho;
+    let normal = alpha * kappa;
+    [
+        scale * (slope * tan[0] - normal * n_i[0]),
+        scale * (slope * tan[1] - normal * n_i[1]),
+        scale * (slope * tan[2] - normal * n_i[2]),
+    ]
 }
 
 /// F22 (30) recoil: the vapour's pressure p_v(T) (F22 (10), the law of the

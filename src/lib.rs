@@ -20,4 +20,5 @@ pub mod run;
 pub mod scene;
 pub mod setup;
 pub mod state;
+pub mod track;
 pub mod watchdog;

@@ -340,6 +340,11 @@ fn cmd_run(
             h.pool_length
         );
     }
+    if let Some(t) = &report.track {
+        for line in t.summary(loaded.model.dim) {
+            println!("{line}");
+        }
+    }
     if loaded.model.has_walls_and_fluid() {
         println!("wall leakage: {}", report.leakage.summary());
     }

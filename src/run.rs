@@ -125,6 +125,8 @@ pub struct RunReport {
     pub last_checkpoint: Option<PathBuf>,
     /// Wall leakage over every state the run read back (issue 18).
     pub leakage: watchdog::Leakage,
+    /// The melt track of a laser scene (issue 16).
+    pub track: Option<crate::track::TrackProfile>,
 }
 
 impl RunReport {
@@ -308,6 +310,7 @@ pub fn run(
     if let Some(c) = checker.as_mut() {
         c.observe(m, &st);
     }
+    let mut track = crate::track::Track::new(m, &st);
     let cap = chunk_cap(st.len());
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
@@ -377,6 +380,9 @@ pub fn run(
             );
         }
         last_good = st.clone();
+        if let Some(t) = track.as_mut() {
+            t.observe(m, &st);
+        }
         if due.1 {
             out.diagnostics(m, &st).map_err(rt)?;
         }
@@ -424,6 +430,14 @@ pub fn run(
             fin
         }
     };
+    let track = track.map(|mut t| {
+        t.observe(m, &final_state);
+        t.finish(m, &final_state)
+    });
+    if let (Some(sink), Some(profile)) = (out.mcap.as_mut(), track.as_ref()) {
+        sink.track(final_state.sim.time as f64, profile)
+            .map_err(rt)?;
+    }
     out.finish().map_err(rt)?;
     let wall_s = start.elapsed().as_secs_f64();
     let check = match end {
@@ -440,6 +454,7 @@ pub fn run(
         end,
         last_checkpoint: out.last_checkpoint.clone(),
         leakage,
+        track,
     })
 }
 

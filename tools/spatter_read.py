@@ -9,11 +9,15 @@ Commands:
     spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
     spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
     spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
+    spatter_read.py track RUN.mcap OUT.png       laser track: remelt depth and surface height along x,
+                                                 and a cross-section of the last frame (2D: the x-z
+                                                 plane; 3D: y-z through the track's middle)
 
 As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
 (time, {field: numpy array}) of the particles still in the simulation;
 info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
-speed, mass); read_vtu(path) -> {field: numpy array}.
+speed, mass); info["track"] is the /track message of a laser scene (None
+without); read_vtu(path) -> {field: numpy array}.
 A file whose writer was killed (no summary) is read up to its last complete chunk.
 """
 import json
@@ -83,7 +87,7 @@ def _messages(path):
 
 def read_mcap(path):
     frames, diagnostics, removed = [], [], []
-    info = {"schemas": {}, "metadata": {}}
+    info = {"schemas": {}, "metadata": {}, "track": None}
     for schema, channel, message, decoded in _messages(path):
         info["schemas"][channel.topic] = schema.name if schema else ""
         if channel.topic == "/particles":
@@ -92,6 +96,8 @@ def read_mcap(path):
             diagnostics.append(decoded)
         elif channel.topic == "/removed":
             removed.append(decoded)
+        elif channel.topic == "/track":
+            info["track"] = decoded
     info["removed"] = sorted(removed, key=lambda r: (r["time"], r["id"]))
     info["complete"] = is_complete(path)
     info["metadata"] = read_metadata(path)
@@ -154,6 +160,7 @@ def summary(path):
         "removed_by_side": {side: sum(1 for r in info["removed"] if r["side"] == side)
                             for side in sorted({r["side"] for r in info["removed"]})},
         "schemas": info["schemas"],
+        "track_slices": len(info["track"]["slices"]) if info["track"] else None,
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),
     }
@@ -177,6 +184,55 @@ def plot(path, png):
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("simulated time (s)")
     fig.suptitle(Path(path).name)
+    fig.tight_layout()
+    fig.savefig(png, dpi=100)
+
+
+def track(path, png):
+    """Profile of the track along x and a cross-section of the last frame."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    frames, _, info = read_mcap(path)
+    tr = info["track"]
+    if not tr or not tr["slices"]:
+        raise SystemExit(f"{path}: no /track (not a laser scene with melting, or nothing melted)")
+    s = tr["slices"]
+    x = np.array([v["x"] for v in s]) * 1e6
+    depth = np.array([v["depth"] for v in s]) * 1e6
+    height = np.array([v["height"] for v in s]) * 1e6
+    fig, (a, b) = plt.subplots(2, 1, figsize=(10, 8))
+    a.axhline(0.0, color="red", lw=1, label="initial surface")
+    a.step(x, height, where="mid", label="resolidified surface")
+    a.step(x, -depth, where="mid", label="remelt depth (negative down)")
+    if any(v["width"] > 0 for v in s):
+        a.step(x, np.array([v["width"] for v in s]) * 1e6, where="mid", label="track width")
+    a.set_xlabel("x (µm)")
+    a.set_ylabel("µm")
+    a.legend(fontsize=8)
+    a.grid(True, alpha=0.3)
+    p = tr["pool"]
+    a.set_title(f"track: peak T {p['max_temperature']:.0f} K, deepest {p['max_depth'] * 1e6:.1f} µm, "
+                f"longest pool {p['max_length'] * 1e6:.0f} µm")
+    t, f = frames[-1]
+    three_d = np.ptp(f["z"]) > 0
+    if three_d:
+        mid = 0.5 * (x[0] + x[-1]) * 1e-6
+        near = np.abs(f["x"] - mid) <= 0.5 * tr["dx"]
+        h, v = f["y"][near], f["z"][near]
+        c = f["temperature"][near] if "temperature" in f else f["phase"][near]
+        b.set_xlabel(f"y (µm), slice x = {mid * 1e6:.0f} µm")
+        b.axhline(s[len(s) // 2]["initial_surface"] * 1e6, color="red", lw=1)
+    else:
+        h, v = f["x"], f["y"]
+        c = f["temperature"] if "temperature" in f else f["phase"]
+        b.set_xlabel("x (µm)")
+        b.step(x, np.array([v_["initial_surface"] for v_ in s]) * 1e6, where="mid", color="red", lw=1)
+    sc = b.scatter(h * 1e6, v * 1e6, c=c, s=6, cmap="inferno")
+    fig.colorbar(sc, ax=b, label="temperature (K)" if "temperature" in f else "phase")
+    b.set_ylabel("up (µm)")
+    b.set_aspect("equal")
+    b.set_title(f"cross-section at t = {t:.4e} s (red: initial surface)")
     fig.tight_layout()
     fig.savefig(png, dpi=100)
 
@@ -218,6 +274,8 @@ def main(argv):
         print(json.dumps(summary(path)))
     elif cmd == "plot" and len(argv) == 4:
         plot(path, argv[3])
+    elif cmd == "track" and len(argv) == 4:
+        track(path, argv[3])
     elif cmd == "export-last" and len(argv) == 4:
         export_last(path, argv[3])
     elif cmd == "compare-vtk" and len(argv) == 4:

@@ -1,6 +1,7 @@
-//! MCAP stream: `/particles` (foxglove.PointCloud, protobuf), `/diagnostics`
-//! and `/removed` (one message per particle leaving the domain; JSON with a JSON
-//! schema), zstd-compressed chunks, the resolved scenario as
+//! MCAP stream: `/particles` (foxglove.PointCloud, protobuf), `/diagnostics`,
+//! `/removed` (one message per particle leaving the domain) and, in scenes with a
+//! laser and melting, `/track` (one message at the end: crate::track) (JSON with
+//! JSON schemas), zstd-compressed chunks, the resolved scenario as
 //! metadata. Every message closes its chunk and flushes, so a process killed hard
 //! leaves a file readable up to its last message; `finish` (or Drop) writes the
 //! summary and footer on every other ending.
@@ -18,6 +19,7 @@ use std::io::BufWriter;
 pub const PARTICLES_TOPIC: &str = "/particles";
 pub const DIAGNOSTICS_TOPIC: &str = "/diagnostics";
 pub const REMOVED_TOPIC: &str = "/removed";
+pub const TRACK_TOPIC: &str = "/track";
 /// Name of the metadata record holding the run's provenance.
 pub const METADATA_NAME: &str = "spatter";
 
@@ -27,6 +29,7 @@ pub struct McapSink {
     particles: u16,
     diagnostics: u16,
     removed: u16,
+    track: Option<u16>,
     /// Ids whose removal is written (None until the first state: a resumed run's
     /// earlier removals are in the earlier file).
     reported: Option<std::collections::HashSet<u32>>,
@@ -88,6 +91,21 @@ impl McapSink {
         let removed = w
             .add_channel(removed_schema, REMOVED_TOPIC, "json", &none)
             .map_err(|e| err(&e))?;
+        let track = if crate::track::wanted(m) {
+            let schema = w
+                .add_schema(
+                    "spatter.Track",
+                    "jsonschema",
+                    track_schema().to_string().as_bytes(),
+                )
+                .map_err(|e| err(&e))?;
+            Some(
+                w.add_channel(schema, TRACK_TOPIC, "json", &none)
+                    .map_err(|e| err(&e))?,
+            )
+        } else {
+            None
+        };
         let meta = BTreeMap::from([
             (
                 "spatter_version".to_string(),
@@ -110,6 +128,7 @@ impl McapSink {
             particles,
             diagnostics,
             removed,
+            track,
             reported: None,
             sequence: 0,
             frames: 0,
@@ -167,6 +186,15 @@ impl McapSink {
         Ok(())
     }
 
+    /// The `/track` message (scenes with a track only), at the run's end time.
+    pub fn track(&mut self, time: f64, profile: &crate::track::TrackProfile) -> Result<(), String> {
+        let Some(channel) = self.track else {
+            return Ok(());
+        };
+        let json = serde_json::to_vec(profile).map_err(|e| e.to_string())?;
+        self.write(channel, time, &json)
+    }
+
     /// Write the summary and footer. Safe to call more than once.
     pub fn finish(&mut self) -> Result<(), String> {
         if let Some(mut w) = self.writer.take() {
@@ -196,6 +224,47 @@ fn removal_schema() -> serde_json::Value {
             "mass": num("kg (per metre of depth in 2D)")
         },
         "required": ["id", "phase", "time", "side", "x", "y", "z", "speed", "mass"]
+    })
+}
+
+/// JSON schema of the `/track` message (crate::track::TrackProfile).
+fn track_schema() -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Track",
+        "type": "object",
+        "properties": {
+            "dx": num("slice width along x, m"),
+            "slices": {
+                "type": "array",
+                "description": "slices of width dx along x that the melt reached, in x order",
+                "items": {
+                    "type": "object",
+                    "properties": {
+                        "x": num("slice centre, m"),
+                        "initial_surface": num("top of the condensed material at the start, m (up axis)"),
+                        "depth": num("depth the melt reached below the initial surface, m"),
+                        "width": num("extent of the melt along y, m (0 in 2D)"),
+                        "height": num("resolidified surface minus initial surface, m (on the beam line in 3D)"),
+                        "peak_temperature": num("K")
+                    }
+                }
+            },
+            "pool": {
+                "type": "object",
+                "description": "the melt pool's extremes over the run's samples",
+                "properties": {
+                    "max_temperature": num("K"),
+                    "max_temperature_time": num("s"),
+                    "max_depth": num("m, below the top of the condensed material"),
+                    "max_depth_time": num("s"),
+                    "max_length": num("extent along x, m"),
+                    "max_width": num("extent along y, m (0 in 2D)")
+                }
+            }
+        },
+        "required": ["dx", "slices", "pool"]
     })
 }
 

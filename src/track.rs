@@ -1,0 +1,287 @@
+//! The melt track a laser scan leaves (issue 16 item 7): per slice of width Δx
+//! along x (the scan axis of the scenes), the depth the melt reached below the
+//! initial surface, the track's width (3D), the height of the resolidified
+//! surface relative to the initial one and the peak temperature; and the melt
+//! pool's figures over the whole run (hottest, deepest, longest).
+//!
+//! Host side, from the states the run reads back anyway (every frame and
+//! diagnostics sample): the depth and width are the extremes of the samples, so a
+//! pool that reaches deeper between two samples is seen at the next one only if
+//! it is still there (output_interval × scan speed is the resolution along the
+//! track: 20 µm at 1e-5 s and 2 m/s). A resumed run starts its track at the resume.
+//!
+//! - Melt in the pool: a particle of a conducting condensed phase with liquid
+//!   fraction ≥ ½ whose lower edge is below the initial surface of its slice (a
+//!   droplet flying or lying above the surface is not the pool).
+//! - Initial surface: per slice, the highest condensed (liquid or solid) particle
+//!   at the first state, + ½Δx.
+//! - Depth: initial surface − (lowest melt particle ever seen in the slice − ½Δx);
+//!   the track is the slices whose depth exceeds ½Δx.
+//! - Width (3D): extent along y of the melt ever seen in the slice, + Δx.
+//! - Height: the top of the slice's condensed column at the end + ½Δx − initial
+//!   surface, on the beam's line in 3D (|y − y_beam| ≤ Δx); the column is read
+//!   from the bottom up and ends at the first gap wider than 1.5Δx, so a droplet
+//!   flying above the surface does not count as surface.
+
+use crate::model::Model;
+use crate::output::world_coord;
+use crate::scene::PhaseKind;
+use crate::state::State;
+use serde::Serialize;
+
+pub struct Track {
+    x0: f64,
+    dx: f64,
+    up: usize,
+    /// Beam line (y) in 3D.
+    y_beam: f64,
+    initial_top: Vec<f64>,
+    lowest_melt: Vec<f64>,
+    melt_y: Vec<[f64; 2]>,
+    peak_t: Vec<f64>,
+    pub pool: PoolPeaks,
+}
+
+/// The melt pool's extremes over the samples of the run: the hottest particle
+/// (any), the deepest melt below the initial surface, the longest (x) and widest
+/// (y, 3D) extent of the melt in the pool.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct PoolPeaks {
+    pub max_temperature: f64,
+    pub max_temperature_time: f64,
+    pub max_depth: f64,
+    pub max_depth_time: f64,
+    pub max_length: f64,
+    pub max_width: f64,
+}
+
+/// One slice of the track (only slices the melt reached).
+#[derive(Debug, Clone, Serialize)]
+pub struct Slice {
+    /// Slice centre, m.
+    pub x: f64,
+    /// The initial surface (top of the condensed material + ½Δx), m.
+    pub initial_surface: f64,
+    pub depth: f64,
+    /// 0 in 2D.
+    pub width: f64,
+    pub height: f64,
+    pub peak_temperature: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackProfile {
+    pub dx: f64,
+    pub slices: Vec<Slice>,
+    pub pool: PoolPeaks,
+}
+
+fn condensed(m: &Model, st: &State, i: usize) -> bool {
+    let ph = &m.phases[st.phase[i] as usize];
+    ph.conducts() && matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid)
+}
+
+/// Scenes with a laser and a phase that melts have a track.
+pub fn wanted(m: &Model) -> bool {
+    m.laser.is_some()
+        && m.phases
+            .iter()
+            .any(|p| p.thermal.and_then(|t| t.melting).is_some())
+}
+
+impl Track {
+    pub fn new(m: &Model, st: &State) -> Option<Track> {
+        if !wanted(m) || st.heat.is_empty() {
+            return None;
+        }
+        let laser = m.laser.as_ref()?;
+        let slices = ((m.domain_hi[0] - m.domain_lo[0]) / m.dx).ceil().max(1.0) as usize;
+        let y_beam =
+            laser.path.iter().map(|p| p.1[1]).sum::<f64>() / laser.path.len().max(1) as f64;
+        let mut t = Track {
+            x0: m.domain_lo[0],
+            dx: m.dx,
+            up: m.dim as usize - 1,
+            y_beam,
+            initial_top: vec![f64::NEG_INFINITY; slices],
+            lowest_melt: vec![f64::INFINITY; slices],
+            melt_y: vec![[f64::INFINITY, f64::NEG_INFINITY]; slices],
+            peak_t: vec![f64::NEG_INFINITY; slices],
+            pool: PoolPeaks::default(),
+        };
+        for i in 0..st.active() {
+            if condensed(m, st, i) {
+                if let Some(k) = t.slice(m, st, i) {
+                    let z = world_coord(m, st, i, t.up) as f64 + 0.5 * m.dx;
+                    t.initial_top[k] = t.initial_top[k].max(z);
+                }
+            }
+        }
+        t.observe(m, st);
+        Some(t)
+    }
+
+    fn slice(&self, m: &Model, st: &State, i: usize) -> Option<usize> {
+        let x = world_coord(m, st, i, 0) as f64;
+        let k = ((x - self.x0) / self.dx).floor();
+        (k >= 0.0 && (k as usize) < self.initial_top.len()).then_some(k as usize)
+    }
+
+    /// Take in one state read back during the run.
+    pub fn observe(&mut self, m: &Model, st: &State) {
+        let time = st.sim.time as f64;
+        let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+        let mut deepest = f64::NEG_INFINITY;
+        for i in 0..st.active() {
+            if !condensed(m, st, i) {
+                continue;
+            }
+            let [_, t, fl, _] = st.heat[i];
+            if t as f64 > self.pool.max_temperature {
+                self.pool.max_temperature = t as f64;
+                self.pool.max_temperature_time = time;
+            }
+            let Some(k) = self.slice(m, st, i) else {
+                continue;
+            };
+            self.peak_t[k] = self.peak_t[k].max(t as f64);
+            let z = world_coord(m, st, i, self.up) as f64;
+            // Melt in the pool: below the initial surface (a droplet flying or
+            // lying above it is not the pool).
+            if fl < 0.5 || z - 0.5 * self.dx >= self.initial_top[k] {
+                continue;
+            }
+            self.lowest_melt[k] = self.lowest_melt[k].min(z);
+            deepest = deepest.max(self.initial_top[k] - (z - 0.5 * self.dx));
+            for (a, e) in extent.iter_mut().enumerate().take(m.dim as usize - 1) {
+                let c = world_coord(m, st, i, a) as f64;
+                *e = [e[0].min(c), e[1].max(c)];
+            }
+            if m.dim == 3 {
+                let y = world_coord(m, st, i, 1) as f64;
+                self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
+            }
+        }
+        if deepest > self.pool.max_depth {
+            self.pool.max_depth = deepest;
+            self.pool.max_depth_time = time;
+        }
+        if extent[0][0].is_finite() {
+            self.pool.max_length = self
+                .pool
+                .max_length
+                .max(extent[0][1] - extent[0][0] + self.dx);
+            if m.dim == 3 {
+                self.pool.max_width = self
+                    .pool
+                    .max_width
+                    .max(extent[1][1] - extent[1][0] + self.dx);
+            }
+        }
+    }
+
+    /// The profile from the final state (the resolidified surface).
+    pub fn finish(&self, m: &Model, st: &State) -> TrackProfile {
+        let n = self.initial_top.len();
+        let mut columns: Vec<Vec<f64>> = vec![Vec::new(); n];
+        for i in 0..st.active() {
+            if !condensed(m, st, i) {
+                continue;
+            }
+            if m.dim == 3 && (world_coord(m, st, i, 1) as f64 - self.y_beam).abs() > self.dx {
+                continue;
+            }
+            if let Some(k) = self.slice(m, st, i) {
+                columns[k].push(world_coord(m, st, i, self.up) as f64);
+            }
+        }
+        // Slices the melt reached at least half a row below the initial surface.
+        let remelted =
+            |k: usize| self.initial_top[k] - (self.lowest_melt[k] - 0.5 * self.dx) > 0.5 * self.dx;
+        let slices = (0..n)
+            .filter(|&k| self.initial_top[k].is_finite() && remelted(k))
+            .map(|k| {
+                let top =
+                    column_top(&mut columns[k], self.dx).map_or(f64::NAN, |z| z + 0.5 * self.dx);
+                Slice {
+                    x: self.x0 + (k as f64 + 0.5) * self.dx,
+                    initial_surface: self.initial_top[k],
+                    depth: self.initial_top[k] - (self.lowest_melt[k] - 0.5 * self.dx),
+                    width: if m.dim == 3 {
+                        self.melt_y[k][1] - self.melt_y[k][0] + self.dx
+                    } else {
+                        0.0
+                    },
+                    height: top - self.initial_top[k],
+                    peak_temperature: self.peak_t[k],
+                }
+            })
+            .collect();
+        TrackProfile {
+            dx: self.dx,
+            slices,
+            pool: self.pool,
+        }
+    }
+}
+
+/// The top of the column that stands on the bottom: up from the lowest particle
+/// while each next one is within 1.5Δx.
+fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
+    zs.sort_by(|a, b| a.total_cmp(b));
+    let first = *zs.first()?;
+    Some(
+        zs.windows(2)
+            .find(|w| w[1] - w[0] > 1.5 * dx)
+            .map_or(zs[zs.len() - 1], |w| w[0])
+            .max(first),
+    )
+}
+
+impl TrackProfile {
+    /// Lines for the end of a run.
+    pub fn summary(&self, dim: u32) -> Vec<String> {
+        let p = &self.pool;
+        let mut lines = vec![format!(
+            "melt pool: peak temperature {:.1} K (t = {:.4e} s), deepest {:.3e} m (t = {:.4e} s), longest {:.3e} m{}",
+            p.max_temperature,
+            p.max_temperature_time,
+            p.max_depth,
+            p.max_depth_time,
+            p.max_length,
+            if dim == 3 { format!(", widest {:.3e} m", p.max_width) } else { String::new() }
+        )];
+        let s = &self.slices;
+        if s.is_empty() {
+            lines.push("track: nothing melted".into());
+            return lines;
+        }
+        let stats = |f: &dyn Fn(&Slice) -> f64| {
+            let v: Vec<f64> = s.iter().map(f).filter(|v| v.is_finite()).collect();
+            let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            format!("mean {mean:.3e} m (min {lo:.3e}, max {hi:.3e})")
+        };
+        // The first and last tenth of the melted slices: where the scan starts and ends.
+        let tenth = (s.len() / 10).max(1);
+        let mean_depth =
+            |part: &[Slice]| part.iter().map(|x| x.depth).sum::<f64>() / part.len() as f64;
+        let mut track = format!(
+            "track: {} slices of {:.1e} m melted, x from {:.4e} to {:.4e} m: remelt depth {}; first tenth {:.3e} m, last tenth {:.3e} m; surface height {} relative to the initial surface",
+            s.len(),
+            self.dx,
+            s[0].x,
+            s[s.len() - 1].x,
+            stats(&|x| x.depth),
+            mean_depth(&s[..tenth]),
+            mean_depth(&s[s.len() - tenth..]),
+            stats(&|x| x.height),
+        );
+        if dim == 3 {
+            track.push_str(&format!("; width {}", stats(&|x| x.width)));
+        }
+        lines.push(track);
+        lines
+    }
+}

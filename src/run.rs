@@ -12,6 +12,7 @@ use crate::params::Params;
 use crate::scene;
 use crate::setup;
 use crate::state::{dt_limit_name, State};
+use crate::track::Track;
 use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -159,7 +160,7 @@ impl Outputs {
         }
         Ok(())
     }
-    fn diagnostics(&mut self, m: &Model, st: &State) -> Result<(), String> {
+    fn diagnostics(&mut self, m: &Model, st: &State, track: Option<&Track>) -> Result<(), String> {
         if self.last_diag_step == Some(st.sim.step) {
             return Ok(());
         }
@@ -167,7 +168,9 @@ impl Outputs {
         match self.mcap.as_mut() {
             Some(s) => {
                 s.removals(m, st)?;
-                s.diagnostics(&output::diagnostics(m, st))
+                let mut d = output::diagnostics(m, st);
+                d.depression_depth = track.and_then(|t| t.depression(m, st));
+                s.diagnostics(&d)
             }
             None => Ok(()),
         }
@@ -305,12 +308,12 @@ pub fn run(
     let mut sim = st.sim;
     let start_step = sim.step as u64;
     let mut sched = Schedule::new(m, sim.time as f64, out.checkpoint_every);
+    let mut track = Track::new(m, &st);
     out.frame(m, &st).map_err(rt)?;
-    out.diagnostics(m, &st).map_err(rt)?;
+    out.diagnostics(m, &st, track.as_ref()).map_err(rt)?;
     if let Some(c) = checker.as_mut() {
         c.observe(m, &st);
     }
-    let mut track = crate::track::Track::new(m, &st);
     let cap = chunk_cap(st.len());
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
@@ -384,7 +387,7 @@ pub fn run(
             t.observe(m, &st);
         }
         if due.1 {
-            out.diagnostics(m, &st).map_err(rt)?;
+            out.diagnostics(m, &st, track.as_ref()).map_err(rt)?;
         }
         if due.0 {
             out.frame(m, &st).map_err(rt)?;
@@ -414,7 +417,7 @@ pub fn run(
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
             leakage.absorb(watchdog::leakage(m, &bad));
             out.frame(m, &bad).map_err(rt)?;
-            out.diagnostics(m, &bad).map_err(rt)?;
+            out.diagnostics(m, &bad, track.as_ref()).map_err(rt)?;
             out.checkpoint(m, &good).map_err(rt)?;
             end = RunEnd::Unstable(precise);
             bad
@@ -423,7 +426,7 @@ pub fn run(
             let fin = fin.expect("the final state is read when nothing tripped");
             leakage.absorb(watchdog::leakage(m, &fin));
             out.frame(m, &fin).map_err(rt)?;
-            out.diagnostics(m, &fin).map_err(rt)?;
+            out.diagnostics(m, &fin, track.as_ref()).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
                 out.checkpoint(m, &fin).map_err(rt)?;
             }

@@ -53,6 +53,9 @@ pub struct PoolPeaks {
     pub max_depth_time: f64,
     pub max_length: f64,
     pub max_width: f64,
+    /// Deepest the surface under the beam sank below the initial surface.
+    pub max_depression: f64,
+    pub max_depression_time: f64,
 }
 
 /// One slice of the track (only slices the melt reached).
@@ -162,6 +165,12 @@ impl Track {
                 self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
             }
         }
+        if let Some(d) = self.depression(m, st) {
+            if d > self.pool.max_depression {
+                self.pool.max_depression = d;
+                self.pool.max_depression_time = time;
+            }
+        }
         if deepest > self.pool.max_depth {
             self.pool.max_depth = deepest;
             self.pool.max_depth_time = time;
@@ -178,6 +187,50 @@ impl Track {
                     .max(extent[1][1] - extent[1][0] + self.dx);
             }
         }
+    }
+
+    /// Depth of the surface under the beam below the initial surface (m; > 0:
+    /// sunk): the column top of the slice under the beam centre (on the beam line
+    /// in 3D), as `finish` reads it. None while the beam is outside the slices or
+    /// the column is empty.
+    pub fn depression(&self, m: &Model, st: &State) -> Option<f64> {
+        let laser = m.laser.as_ref()?;
+        let c = laser.centre_at(st.sim.time as f64);
+        let k = ((c[0] - self.x0) / self.dx).floor();
+        if k < 0.0 || k as usize >= self.initial_top.len() {
+            return None;
+        }
+        let k = k as usize;
+        let mut zs: Vec<f64> = (0..st.active())
+            .filter(|&i| condensed(m, st, i) && self.slice(m, st, i) == Some(k))
+            .filter(|&i| m.dim < 3 || (world_coord(m, st, i, 1) as f64 - c[1]).abs() <= self.dx)
+            .map(|i| world_coord(m, st, i, self.up) as f64)
+            .collect();
+        let top = column_top(&mut zs, self.dx)? + 0.5 * self.dx;
+        Some(self.initial_top[k] - top)
+    }
+
+    /// The hottest condensed particle within the beam radius of its centre
+    /// (laterally), K.
+    pub fn beam_temperature(&self, m: &Model, st: &State) -> f64 {
+        let Some(laser) = m.laser.as_ref() else {
+            return f64::NAN;
+        };
+        let c = laser.centre_at(st.sim.time as f64);
+        let mut hottest = f64::NEG_INFINITY;
+        for i in 0..st.active() {
+            if !condensed(m, st, i) {
+                continue;
+            }
+            let mut d2 = 0.0;
+            for a in 0..m.dim as usize - 1 {
+                d2 += (world_coord(m, st, i, a) as f64 - c[a]).powi(2);
+            }
+            if d2 <= laser.radius * laser.radius {
+                hottest = hottest.max(st.heat[i][1] as f64);
+            }
+        }
+        hottest
     }
 
     /// The profile from the final state (the resolidified surface).
@@ -243,12 +296,14 @@ impl TrackProfile {
     pub fn summary(&self, dim: u32) -> Vec<String> {
         let p = &self.pool;
         let mut lines = vec![format!(
-            "melt pool: peak temperature {:.1} K (t = {:.4e} s), deepest {:.3e} m (t = {:.4e} s), longest {:.3e} m{}",
+            "melt pool: peak temperature {:.1} K (t = {:.4e} s), deepest {:.3e} m (t = {:.4e} s), longest {:.3e} m, surface under the beam at most {:.3e} m below the initial surface (t = {:.4e} s){}",
             p.max_temperature,
             p.max_temperature_time,
             p.max_depth,
             p.max_depth_time,
             p.max_length,
+            p.max_depression,
+            p.max_depression_time,
             if dim == 3 { format!(", widest {:.3e} m", p.max_width) } else { String::new() }
         )];
         let s = &self.slices;

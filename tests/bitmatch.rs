@@ -346,6 +346,9 @@ fn line_melt_with_every_force_200_steps() {
         "{}/scenarios/pbf/line_melt_coarse_2d.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    let sets = ["phases.plate.temperature=1650.0", "laser.power=[[0.0, 4.0e6]]"];
+    let sets = [
+        "phases.plate.temperature=1650.0",
+        "laser.power=[[0.0, 4.0e6]]",
+    ];
     assert_bit_identical_at(&path, &sets, 200);
 }

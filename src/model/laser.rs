@@ -27,6 +27,25 @@ impl Laser {
             .find(|p| p.0 <= t)
             .map_or(0.0, |p| p.1)
     }
+    /// Lateral beam centre at time t (absolute; linear along the path, held at
+    /// its ends), as the laser pass moves it.
+    pub fn centre_at(&self, t: f64) -> [f64; 2] {
+        let path = &self.path;
+        if path.is_empty() {
+            return [0.0; 2];
+        }
+        if t <= path[0].0 {
+            return path[0].1;
+        }
+        for w in path.windows(2) {
+            let ((t0, p0), (t1, p1)) = (w[0], w[1]);
+            if t < t1 {
+                let f = (t - t0) / (t1 - t0);
+                return [p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1])];
+            }
+        }
+        path[path.len() - 1].1
+    }
     /// Energy the beam delivers over [0, t] (J; J per metre of depth in 2D).
     pub fn energy_until(&self, t: f64) -> f64 {
         let mut e = 0.0;

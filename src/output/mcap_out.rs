@@ -260,7 +260,9 @@ fn track_schema() -> serde_json::Value {
                     "max_depth": num("m, below the top of the condensed material"),
                     "max_depth_time": num("s"),
                     "max_length": num("extent along x, m"),
-                    "max_width": num("extent along y, m (0 in 2D)")
+                    "max_width": num("extent along y, m (0 in 2D)"),
+                    "max_depression": num("deepest the surface under the beam sank below the initial surface, m"),
+                    "max_depression_time": num("s")
                 }
             }
         },

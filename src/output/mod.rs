@@ -198,6 +198,10 @@ pub struct Diagnostics {
     /// Scenes with surface tension or recoil only.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub surface: Option<SurfaceDiagnostics>,
+    /// Scenes with a melt track (crate::track): depth of the surface under the
+    /// beam below the initial surface, m (set by the run, which holds the track).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depression_depth: Option<f64>,
 }
 
 /// Surface-force diagnostics (issue 16): the liquid's surface as the interface
@@ -361,6 +365,7 @@ pub fn diagnostics(m: &Model, st: &State) -> Diagnostics {
         wall_penetration_count: 0,
         heat: heat_diagnostics(m, st),
         surface: surface_diagnostics(m, st),
+        depression_depth: None,
     };
     let leak = crate::watchdog::leakage(m, st);
     (d.wall_penetration_max_dx, d.wall_penetration_count) = (leak.deepest_dx, leak.beyond_half_dx);
@@ -490,6 +495,11 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         for (k, desc) in extra {
             schema["properties"][k] = num(&desc);
         }
+    }
+    if crate::track::wanted(m) {
+        schema["properties"]["depression_depth"] = num(
+            "depth of the surface under the beam below the initial surface, m (> 0: sunk; absent while the beam is outside the domain)",
+        );
     }
     schema
 }

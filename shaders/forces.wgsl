@@ -1,7 +1,8 @@
 // uses: params bindings consts kernel grid phase
 // writes: acc acc_b
 // Pressure + viscous forces F22 (23), transport-velocity background pressure
-// (Adami 2013), interface viscosity F22 (31), viscous heating, the wall barrier
+// (Adami 2013), interface viscosity F22 (31), solid-fluid viscosity F22 (33),
+// viscous heating, the wall barrier
 // F22 (34) and gravity: one
 // sweep over the neighbours, each pair term a function in shaders/terms/ (the
 // host appends the pass's terms; a switchable term is removed at pipeline
@@ -35,6 +36,10 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     // α_0 had been factored out of α_i + α_j (the CPU multiplies each).
     if (TERM_INTERFACE_VISCOSITY && P.flow.interface_viscosity > 0.0) {
         alpha_i = interface_viscosity_alpha(surface[i].w);
+    }
+    var alpha_sf_i = 0.0;
+    if (TERM_SOLID_FLUID_VISCOSITY) {
+        alpha_sf_i = solid_fluid_viscosity_alpha(phase[i], heat[i].y);
     }
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
@@ -73,6 +78,19 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
             if (TERM_INTERFACE_VISCOSITY && !wall) {
                 let alpha = (alpha_i + interface_viscosity_alpha(surface[j].w)) * c_half();
                 let s = interface_viscosity(m_i, m_j, rho_i, rho_j, c2_i, P.phases[ph_j].c2, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] + s * d[a];
+                }
+            }
+            if (TERM_SOLID_FLUID_VISCOSITY) {
+                var alpha_j = alpha_sf_i;
+                var c2_j = c2_i;
+                if (!wall) {
+                    alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j].y);
+                    c2_j = P.phases[ph_j].c2;
+                }
+                let alpha = (alpha_sf_i + alpha_j) * c_half();
+                let s = solid_fluid_viscosity(m_i, m_j, rho_i, rho_j, c2_i, c2_j, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
                 for (var a = 0u; a < 3u; a++) {
                     f[a] = f[a] + s * d[a];
                 }

@@ -145,8 +145,9 @@ gpu_struct! {
         pub barrier_radius: f32,
         pub barrier_stiffness: f32,
         pub barrier_damping: f32,
-        pub pad0: f32,
-        pub pad1: f32,
+        /// F22 (33) solid–fluid viscosity α_0^sf (0 = off) and 1/ΔT_d.
+        pub solid_fluid_viscosity: f32,
+        pub solid_fluid_inv_width: f32,
     }
 }
 
@@ -458,8 +459,8 @@ impl Params {
             barrier_radius: m.barrier.map_or(0.0, |b| b.radius as f32),
             barrier_stiffness: m.barrier.map_or(0.0, |b| b.stiffness as f32),
             barrier_damping: m.barrier.map_or(0.0, |b| b.damping as f32),
-            pad0: 0.0,
-            pad1: 0.0,
+            solid_fluid_viscosity: m.solid_fluid_viscosity.map_or(0.0, |s| s.0 as f32),
+            solid_fluid_inv_width: m.solid_fluid_viscosity.map_or(0.0, |s| (1.0 / s.1) as f32),
         };
         for (i, ph) in m.phases.iter().enumerate() {
             p.phases[i] = phase_block(ph);

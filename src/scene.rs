@@ -102,6 +102,16 @@ pub struct SceneFile {
     pub surface_tension: Option<SurfaceTensionDef>,
 }
 
+/// `simulation.solid_fluid_viscosity`: F22 (33)'s α_0^sf and ΔT_d.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidFluidViscosityDef {
+    /// α_0^sf (dimensionless, as α_0^lg).
+    pub coefficient: f64,
+    /// ΔT_d (K): full at the solidus, none at solidus + ΔT_d.
+    pub width: f64,
+}
+
 /// `[surface_tension]`: CSF surface tension with Marangoni, F22 (24)–(26), (8),
 /// between one liquid phase and one gas phase (F22's form, with gas particles),
 /// or at the free surface of a liquid in a scene without gas particles (R18
@@ -187,6 +197,10 @@ pub struct Simulation {
     /// molten steel: 7.2; Table 4, liquid binder: 1.8). Needs a liquid and a gas phase.
     #[serde(default)]
     pub interface_viscosity: f64,
+    /// F22 (33) solid–fluid artificial viscosity: α_i^sf = coefficient ×
+    /// f̄[T_i, T_s, T_s + width] on particles of melting liquids (T_s their
+    /// solidus), in the form of F22 (31) (F22 Table 1: 1.0 and 300 K).
+    pub solid_fluid_viscosity: Option<SolidFluidViscosityDef>,
     /// Seeded random displacement of fluid particles, as a fraction of Δx.
     #[serde(default)]
     pub jitter: f64,

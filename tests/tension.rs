@@ -235,3 +235,35 @@ fn surface_diagnostics_reach_the_mcap() {
     assert!(d["recoil_power"].as_f64().unwrap() > 0.0, "{d}");
     assert_eq!(d["mean_curvature"], 0.0, "{d}");
 }
+
+/// F22 (33)'s solid–fluid viscosity needs a melting liquid and positive values;
+/// `validate` folds it into the viscous Δt limit (α h c/(2(d + 2)): 2.7248e-7 s
+/// for the coarse line melt, α = 1, h = 10 µm, c = 36.7 m/s).
+#[test]
+fn solid_fluid_viscosity_input_and_limit() {
+    let line = format!(
+        "{}/scenarios/pbf/line_melt_coarse_2d.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = spatter(&["validate", &line]);
+    let (stdout, _) = text(&out);
+    assert!(stdout.contains("viscous 2.7248e-7 s"), "{stdout}");
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene("laplace_free_disc_2d"),
+            "--set",
+            "simulation.solid_fluid_viscosity={coefficient=1.0, width=300.0}",
+        ],
+        "simulation.solid_fluid_viscosity",
+    );
+    common::assert_input_error(
+        &[
+            "validate",
+            &line,
+            "--set",
+            "simulation.solid_fluid_viscosity={coefficient=1.0, width=0.0}",
+        ],
+        "simulation.solid_fluid_viscosity.width",
+    );
+}

@@ -49,8 +49,8 @@ struct Flow {
     barrier_radius: f32,      // F22 (34) r_b (0 = off)
     barrier_stiffness: f32,   // k_b
     barrier_damping: f32,     // d_b
-    pad0: f32,
-    pad1: f32,
+    solid_fluid_viscosity: f32,  // F22 (33) alpha_0^sf (0 = off)
+    solid_fluid_inv_width: f32,  // 1 / dT_d
 }
 
 struct Tension {             // F22 (24)-(26), (8), (21)

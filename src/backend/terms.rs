@@ -21,7 +21,7 @@ pub struct PairTerm {
     pub active: fn(&Params) -> bool,
 }
 
-pub const PAIR_TERMS: [PairTerm; 6] = [
+pub const PAIR_TERMS: [PairTerm; 7] = [
     PairTerm {
         name: "pressure",
         pass: "forces",
@@ -49,6 +49,13 @@ pub const PAIR_TERMS: [PairTerm; 6] = [
         wgsl: include_str!("../../shaders/terms/interface_viscosity.wgsl"),
         switch: Some("TERM_INTERFACE_VISCOSITY"),
         active: |p| p.flow.interface_viscosity > 0.0,
+    },
+    PairTerm {
+        name: "solid_fluid_viscosity",
+        pass: "forces",
+        wgsl: include_str!("../../shaders/terms/solid_fluid_viscosity.wgsl"),
+        switch: Some("TERM_SOLID_FLUID_VISCOSITY"),
+        active: |p| p.flow.solid_fluid_viscosity > 0.0,
     },
     PairTerm {
         name: "viscous_heating",

@@ -16,7 +16,7 @@ use domain::{
     open_side_flags,
 };
 pub use domain::{lattice_sites, LATTICE_TOLERANCE};
-use phases::{interface_viscosity_nu, phase_table};
+use phases::{artificial_nu, interface_viscosity_nu, phase_table, solid_fluid_viscosity};
 use thermal::thermal_table;
 
 use crate::error::InputError;
@@ -101,6 +101,8 @@ pub struct Model {
     pub hydrostatic_axis: Option<usize>,
     /// F22 (32) α_0^lg (0 = off).
     pub interface_viscosity: f64,
+    /// F22 (33) (α_0^sf, ΔT_d).
+    pub solid_fluid_viscosity: Option<(f64, f64)>,
     pub viscous_heating: bool,
     pub ambient_temperature: f64,
     pub jitter: f64,
@@ -319,10 +321,12 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         })
         .fold(f64::INFINITY, f64::min);
     let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
-    let nu_max = fluid
-        .iter()
-        .map(|p| p.viscosity / p.rho0)
-        .fold(interface_viscosity_nu(&cx, sim, &fluid, dim, h)?, f64::max);
+    let solid_fluid = solid_fluid_viscosity(&cx, sim, &phases)?;
+    let nu_max = fluid.iter().map(|p| p.viscosity / p.rho0).fold(
+        interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
+            + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
+        f64::max,
+    );
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
     let surface_tension = tension::surface_tension(&cx, scene, &phases)?;
@@ -460,6 +464,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         pressure_floor: sim.pressure_floor,
         hydrostatic_axis,
         interface_viscosity: sim.interface_viscosity,
+        solid_fluid_viscosity: solid_fluid,
         jitter: sim.jitter,
         seed: sim.seed,
         phases,

@@ -230,6 +230,38 @@ fn phase_changes(cx: &Ctx, scene: &SceneFile, phases: &mut [PhaseInfo]) -> Resul
 /// term equals a shear viscosity ν = α h c/(2(d + 2)) (Monaghan 2005), and
 /// α = α_0^lg min(h δ, 1) ≤ α_0^lg (backend/cpu/forces.rs), so the viscous limit
 /// 0.125 h²/ν covers it.
+/// The kinematic viscosity F22 (31) with coefficient α amounts to, α h c/(2(d + 2))
+/// (Monaghan 2005), at the fastest fluid's sound speed: the viscous Δt limit's.
+pub(super) fn artificial_nu(alpha: f64, fluid: &[&PhaseInfo], dim: u32, h: f64) -> f64 {
+    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    alpha * h * c_max / (2.0 * (dim as f64 + 2.0))
+}
+
+/// `simulation.solid_fluid_viscosity`: F22 (33), for heat scenes with a liquid
+/// that melts.
+pub(super) fn solid_fluid_viscosity(
+    cx: &Ctx,
+    sim: &crate::scene::Simulation,
+    phases: &[PhaseInfo],
+) -> Result<Option<(f64, f64)>, InputError> {
+    let Some(d) = sim.solid_fluid_viscosity else {
+        return Ok(None);
+    };
+    let key = "simulation.solid_fluid_viscosity";
+    let alpha = cx.positive(&format!("{key}.coefficient"), d.coefficient)?;
+    let width = cx.positive(&format!("{key}.width"), d.width)?;
+    let melts = phases
+        .iter()
+        .any(|p| p.kind == PhaseKind::Liquid && p.thermal.and_then(|t| t.melting).is_some());
+    if !melts {
+        return Err(cx.err(
+            key,
+            "acts on a melting liquid between its solidus and solidus + width: the scene needs a liquid phase whose material melts (heat scene)",
+        ));
+    }
+    Ok(Some((alpha, width)))
+}
+
 pub(super) fn interface_viscosity_nu(
     cx: &Ctx,
     sim: &crate::scene::Simulation,
@@ -249,6 +281,5 @@ pub(super) fn interface_viscosity_nu(
             "acts at a liquid–gas interface: the scene needs a liquid and a gas phase",
         ));
     }
-    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
-    Ok(alpha * h * c_max / (2.0 * (dim as f64 + 2.0)))
+    Ok(artificial_nu(alpha, fluid, dim, h))
 }

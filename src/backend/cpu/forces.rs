@@ -9,8 +9,8 @@
 //! Each pair term is a function in cpu/terms/ (the twin of shaders/terms/), called
 //! in the order of backend::terms::PAIR_TERMS: pressure and viscosity (summed into
 //! one force, as F22 (23) writes them), background pressure (into acc_b), the
-//! interface viscosity F22 (31)–(32), the viscous heating (into acc.w) and the
-//! wall barrier F22 (34).
+//! interface viscosity F22 (31)–(32), the solid–fluid viscosity F22 (33), the
+//! viscous heating (into acc.w) and the wall barrier F22 (34).
 
 use super::neighbors::{for_each_listed, CellTable, NeighborList};
 use super::terms;
@@ -42,14 +42,16 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     monomorphise!(sweep::<>(pr, st, grid, list); [
         active(pr, "background_pressure"),
         active(pr, "interface_viscosity"),
+        active(pr, "solid_fluid_viscosity"),
         active(pr, "viscous_heating"),
         active(pr, "barrier")
     ])
 }
 
-/// One fused neighbour sweep: BG, IV, VH, BR switch the background pressure, the
-/// interface viscosity, the viscous heating and the wall barrier.
-fn sweep<const BG: bool, const IV: bool, const VH: bool, const BR: bool>(
+/// One fused neighbour sweep: BG, IV, SF, VH, BR switch the background pressure,
+/// the interface viscosity, the solid–fluid viscosity, the viscous heating and
+/// the wall barrier.
+fn sweep<const BG: bool, const IV: bool, const SF: bool, const VH: bool, const BR: bool>(
     pr: &Params,
     st: &mut State,
     grid: &CellTable,
@@ -58,7 +60,7 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool, const BR: bool>(
     let n = st.active();
     let (pos, vel, rho, p, mass, phase) =
         (&st.pos, &st.vel, &st.rho, &st.press, &st.mass, &st.phase);
-    let surface = &st.surface;
+    let (surface, heat) = (&st.surface, &st.heat);
     // Per particle and per phase pair once, what the pair loop would otherwise
     // compute per pair from the same operands: the same bits, fewer divisions.
     let eta_pair = PairViscosity::new(pr);
@@ -82,6 +84,11 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool, const BR: bool>(
             let mut heating = 0.0f32;
             let alpha_i = if IV {
                 terms::interface_viscosity_alpha(pr, surface[i][3])
+            } else {
+                0.0
+            };
+            let alpha_sf_i = if SF {
+                terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][1])
             } else {
                 0.0
             };
@@ -122,6 +129,22 @@ fn sweep<const BG: bool, const IV: bool, const VH: bool, const BR: bool>(
                     let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
                     let s = terms::interface_viscosity(
                         pr, m_i, m_j, rho_i, rho_j, mat_i.c2, mat_j.c2, u, d, r2, dwdr, alpha,
+                    );
+                    for a in 0..3 {
+                        f[a] += s * d[a];
+                    }
+                }
+                if SF {
+                    let alpha_j = if wall {
+                        alpha_sf_i
+                    } else {
+                        terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][1])
+                    };
+                    let alpha = (alpha_sf_i + alpha_j) * 0.5;
+                    let c2_j = if wall { mat_i.c2 } else { mat_j.c2 };
+                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                    let s = terms::solid_fluid_viscosity(
+                        pr, m_i, m_j, rho_i, rho_j, mat_i.c2, c2_j, u, d, r2, dwdr, alpha,
                     );
                     for a in 0..3 {
                         f[a] += s * d[a];

@@ -5,6 +5,7 @@ mod background_pressure;
 mod barrier;
 mod interface_viscosity;
 mod pressure;
+mod solid_fluid_viscosity;
 mod viscosity;
 mod viscous_heating;
 
@@ -12,5 +13,6 @@ pub use background_pressure::background_pressure;
 pub use barrier::barrier;
 pub use interface_viscosity::{interface_viscosity, interface_viscosity_alpha};
 pub use pressure::pressure;
+pub use solid_fluid_viscosity::{solid_fluid_viscosity, solid_fluid_viscosity_alpha};
 pub use viscosity::{pair_viscosity, viscosity};
 pub use viscous_heating::viscous_heating;

@@ -530,6 +530,9 @@ pub enum CheckKind {
     Laplace,
     /// Momentum a free layer gains from the recoil pressure against −∫ p_v A dt.
     RecoilImpulse,
+    /// A 2D drop (a square at the start) relaxed to a disc: the spread of its
+    /// outline's radius over 32 sectors, in Δx.
+    DropShape,
 }
 
 impl CheckKind {
@@ -550,6 +553,7 @@ impl CheckKind {
             CheckKind::Compression => "compression",
             CheckKind::Laplace => "laplace",
             CheckKind::RecoilImpulse => "recoil_impulse",
+            CheckKind::DropShape => "drop_shape",
         }
     }
 }

@@ -110,6 +110,17 @@ pub const SWEEPS: &[Sweep] = &[
         quick: false,
     },
     Sweep {
+        name: "square_drop_2d",
+        text: scene_text!("square_drop_2d"),
+        // dx = 4, 2, 1 mm (divisors of the 0.08 m period): the square's side is
+        // 8, 16, 31 particles.
+        length: 0.04,
+        cells: &[10, 20, 40],
+        expected_order: None,
+        why: "a shape check: the outline spread is a few tenths of dx at every resolution (lattice noise); the capillary number is the figure to watch",
+        quick: false,
+    },
+    Sweep {
         name: "conduction_1d",
         text: scene_text!("conduction_1d"),
         length: 0.01,

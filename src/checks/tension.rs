@@ -211,3 +211,97 @@ impl Check for RecoilImpulse {
         }
     }
 }
+
+/// A 2D drop that starts as a square relaxes to a disc under surface tension:
+/// at the end, the outline's radius (the farthest liquid particle from the
+/// liquid's centroid, + ½Δx) in each of up to 32 equal sectors (fewer on a
+/// coarse drop: about two outline particles each), and its spread max − min in
+/// Δx (the verdict; a lattice-cut disc already shows a few tenths).
+/// Also printed: the mean outline radius against √(A/π) of the liquid's area
+/// (mass / ρ0), and the spurious currents of the run's second half as the
+/// largest speed and the capillary number η|u|/σ.
+#[derive(Default)]
+pub struct DropShape {
+    /// (time, largest liquid or gas speed).
+    speeds: Vec<(f64, f64)>,
+}
+
+const MAX_SECTORS: usize = 32;
+
+impl Check for DropShape {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let speed = particles(m, st)
+            .filter(|p| p.kind == PhaseKind::Liquid || p.kind == PhaseKind::Gas)
+            .map(|p| (p.v[0] * p.v[0] + p.v[1] * p.v[1]).sqrt())
+            .fold(0.0, f64::max);
+        self.speeds.push((st.sim.time as f64, speed));
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let liquid: Vec<[f64; 3]> = particles(m, st)
+            .filter(|p| p.kind == PhaseKind::Liquid)
+            .map(|p| p.x)
+            .collect();
+        let metric = "spread of the drop outline's radius over its sectors, in dx".to_string();
+        if liquid.is_empty() {
+            return (metric, f64::NAN, vec!["  no liquid".into()]).into();
+        }
+        let n = liquid.len() as f64;
+        let c = [
+            liquid.iter().map(|x| x[0]).sum::<f64>() / n,
+            liquid.iter().map(|x| x[1]).sum::<f64>() / n,
+        ];
+        let st_def = m
+            .surface_tension
+            .as_ref()
+            .expect("drop_shape needs surface tension");
+        let liquid_phase = &m.phases[st_def.liquid];
+        let area: f64 = (0..st.active())
+            .filter(|&i| st.phase[i] as usize == st_def.liquid)
+            .map(|i| st.mass[i] as f64 / liquid_phase.rho0)
+            .sum();
+        let r_eq = (area / std::f64::consts::PI).sqrt();
+        // At least two outline particles per sector (one spacing per particle).
+        let sectors =
+            ((std::f64::consts::TAU * r_eq / (2.0 * m.dx)) as usize).clamp(8, MAX_SECTORS);
+        let mut outline = vec![f64::NEG_INFINITY; sectors];
+        for x in &liquid {
+            let (dx, dy) = (x[0] - c[0], x[1] - c[1]);
+            let angle = dy.atan2(dx) + std::f64::consts::PI;
+            let k = ((angle / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
+            outline[k] = outline[k].max((dx * dx + dy * dy).sqrt() + 0.5 * m.dx);
+        }
+        outline.retain(|r| r.is_finite());
+        let lo = outline.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = outline.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let mean = outline.iter().sum::<f64>() / outline.len() as f64;
+        let end = st.sim.time as f64;
+        let speed = self
+            .speeds
+            .iter()
+            .filter(|s| s.0 >= 0.5 * end)
+            .map(|s| s.1)
+            .fold(0.0, f64::max);
+        let ca = liquid_phase.viscosity * speed / st_def.coefficient;
+        let spread = (hi - lo) / m.dx;
+        Verdict {
+            metric,
+            value: spread,
+            details: vec![
+                format!(
+                    "  outline radius {lo:.4e} to {hi:.4e} m over {} sectors (mean {mean:.4e} m; sqrt(A/pi) = {r_eq:.4e} m = {:.1} dx)",
+                    outline.len(),
+                    r_eq / m.dx
+                ),
+                format!(
+                    "  spurious currents (second half): largest speed {speed:.3e} m/s, capillary number eta |u| / sigma = {ca:.3e}"
+                ),
+            ],
+            figures: vec![
+                ("outline_spread_dx".into(), spread),
+                ("max_speed".into(), speed),
+                ("capillary_number".into(), ca),
+            ],
+        }
+    }
+}

@@ -402,6 +402,14 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::RecoilImpulse {
             cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
         }
+        if c.kind == crate::scene::CheckKind::DropShape
+            && (dim != 2 || !surface_tension.as_ref().is_some_and(|s| s.slope == 0.0))
+        {
+            return Err(cx.err(
+                "check.kind",
+                "\"drop_shape\" needs a 2D scene with [surface_tension] of constant coefficient",
+            ));
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;

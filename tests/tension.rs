@@ -231,9 +231,13 @@ fn surface_diagnostics_reach_the_mcap() {
     );
     assert!((kappa * r - 1.0).abs() < 0.15, "{d}");
     assert_eq!(d["recoil_power"], 0.0, "{d}");
+    // η max|u| / σ of the liquid: the spurious currents, well below 0.1.
+    let ca = d["capillary_number"].as_f64().unwrap();
+    assert!(ca > 0.0 && ca < 0.1, "{d}");
     let d = last("recoil_layer_2d", &[]);
     assert!(d["recoil_power"].as_f64().unwrap() > 0.0, "{d}");
     assert_eq!(d["mean_curvature"], 0.0, "{d}");
+    assert_eq!(d["capillary_number"], 0.0, "{d}");
 }
 
 /// F22 (33)'s solid–fluid viscosity needs a melting liquid and positive values;

@@ -207,13 +207,16 @@ pub struct Diagnostics {
 /// Surface-force diagnostics (issue 16): the liquid's surface as the interface
 /// pass sees it (Σ V δ over liquid particles with a normal: m² in 3D, m per metre
 /// of depth in 2D), its δ-weighted mean curvature (1/m; scenes with surface
-/// tension, 0 otherwise) and the power the recoil pressure does on the liquid,
-/// Σ V p_v δ (−n·u) (W; W/m in 2D; 0 without recoil).
+/// tension, 0 otherwise), the power the recoil pressure does on the liquid,
+/// Σ V p_v δ (−n·u) (W; W/m in 2D; 0 without recoil), and the largest liquid
+/// speed as a capillary number η|u|/α0 (the spurious currents of a scene at
+/// rest; 0 without surface tension).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct SurfaceDiagnostics {
     pub surface_area: f64,
     pub mean_curvature: f64,
     pub recoil_power: f64,
+    pub capillary_number: f64,
 }
 
 pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> {
@@ -226,10 +229,16 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
         surface_area: 0.0,
         mean_curvature: 0.0,
         recoil_power: 0.0,
+        capillary_number: 0.0,
     };
+    let mut fastest: f64 = 0.0;
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
         let s = st.surface[i];
+        if ph.kind == PhaseKind::Liquid {
+            let v = st.vel[i];
+            fastest = fastest.max((0..3).map(|a| (v[a] as f64).powi(2)).sum::<f64>().sqrt());
+        }
         if ph.kind != PhaseKind::Liquid || s[3] == 0.0 {
             continue;
         }
@@ -246,6 +255,9 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
         d.mean_curvature /= d.surface_area;
     } else {
         d.mean_curvature = 0.0;
+    }
+    if let Some(t) = &m.surface_tension {
+        d.capillary_number = m.phases[t.liquid].viscosity * fastest / t.coefficient;
     }
     Some(d)
 }
@@ -458,6 +470,9 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         schema["properties"]["recoil_power"] = num(&format!(
             "power of the recoil pressure on the liquid, W{per_depth}"
         ));
+        schema["properties"]["capillary_number"] = num(
+            "largest liquid speed as eta |u| / alpha0 (spurious currents of a drop at rest; 0 without surface tension)",
+        );
     }
     if m.is_thermal() {
         let unit = if m.dim == 2 {

@@ -86,6 +86,78 @@ fn gas_interface(i: u32) {
     }
 }
 
+// F22's chi_j of a wall or solid neighbour: 1 - clamp((T_j - T_m) / dT_s + 1, 0, 1)
+// for a conducting (solid) particle with the tension ramp, 1 otherwise.
+fn solid_weight(j: u32) -> f32 {
+    if (P.tension.inv_ramp_width == 0.0 || !conducts(phase[j])) {
+        return c_one();
+    }
+    return c_one() - min(max((heat[j].y - P.tension.t_melt) * P.tension.inv_ramp_width + c_one(), 0.0), c_one());
+}
+
+// Wetting by a prescribed normal, F22 (27)-(29) (the CPU twin explains it). It
+// reads only its own normal (and the neighbours' positions), so the `wetting`
+// dispatch rewrites surface[i] in place.
+fn wet(i: u32, n: vec4<f32>) -> vec4<f32> {
+    var c = 0.0;
+    var g = vec3<f32>(0.0, 0.0, 0.0);
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        let ph = phase[j];
+        if (r2 >= P.kernel.support2 || r2 <= 0.0 || !is_wall(ph)) { continue; }
+        let r = sqrt(r2);
+        let v = mass[j] / P.phases[ph].rho0 * solid_weight(j);
+        c = c + v * kernel_w(r);
+        let f = v * kernel_dw(r) / r;
+        g.x = g.x + f * d.x;
+        g.y = g.y + f * d.y;
+        g.z = g.z + f * d.z;
+    }
+    let gl = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    if (gl <= c_tenth() * P.kernel.inv_h) {
+        return n;
+    }
+    let ns = vec3<f32>(g.x / gl, g.y / gl, g.z / gl);
+    let nn = n.x * ns.x + n.y * ns.y + n.z * ns.z;
+    var t = vec3<f32>(n.x - nn * ns.x, n.y - nn * ns.y, n.z - nn * ns.z);
+    let tl = sqrt(t.x * t.x + t.y * t.y + t.z * t.z);
+    if (tl > 1e-6) {
+        t = vec3<f32>(t.x / tl, t.y / tl, t.z / tl);
+    } else {
+        t = vec3<f32>(0.0, 0.0, 0.0);
+    }
+    var cs = P.tension.cos_contact;
+    let sn = P.tension.sin_contact;
+    if (phase[i] != P.tension.liquid) {
+        cs = -cs;
+    }
+    let f = min(max(c * c_five(), 0.0), c_one());
+    var m = vec3<f32>(0.0, 0.0, 0.0);
+    for (var a = 0u; a < 3u; a++) {
+        let prescribed = t[a] * sn - ns[a] * cs;
+        m[a] = f * prescribed + (c_one() - f) * n[a];
+    }
+    let ml = sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
+    if (ml > 1e-6) {
+        return vec4<f32>(m.x / ml, m.y / ml, m.z / ml, n.w);
+    }
+    return vec4<f32>(0.0, 0.0, 0.0, n.w);
+}
+
+@compute @workgroup_size(64)
+fn wetting(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let ph = phase[i];
+    let n_i = surface[i];
+    if (n_i.w == 0.0 || (ph != P.tension.liquid && ph != P.tension.gas)) { return; }
+    surface[i] = wet(i, n_i);
+}
+
 @compute @workgroup_size(64)
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);

@@ -35,6 +35,9 @@ pub const FLAG_RECOIL: u32 = 512;
 /// the curvature is capped and smoothed (`tension_smooth`); `tension.gas` is
 /// `NO_PHASE`.
 pub const FLAG_FREE_SURFACE_TENSION: u32 = 1024;
+/// Wetting by a prescribed normal near walls and solids, F22 (27)–(29)
+/// (`tension.cos_contact`, `tension.sin_contact`).
+pub const FLAG_WETTING: u32 = 2048;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -182,8 +185,9 @@ gpu_struct! {
         pub gas: u32,
         /// Free-surface form: |κ| ≤ 1/support (R18's cap 1/(2h) of Wendland); 0 otherwise.
         pub kappa_max: f32,
-        pub pad3: u32,
-        pub pad1: u32,
+        /// cos θ0, sin θ0 of the static contact angle (FLAG_WETTING).
+        pub cos_contact: f32,
+        pub sin_contact: f32,
         pub pad2: u32,
     }
 }
@@ -503,6 +507,11 @@ impl Params {
                 t.inv_ramp_width = (1.0 / width) as f32;
             }
             t.liquid = s.liquid as u32;
+            if let Some(theta) = s.contact_angle {
+                p.sizes.flags |= FLAG_WETTING;
+                t.cos_contact = theta.cos() as f32;
+                t.sin_contact = theta.sin() as f32;
+            }
             match s.gas {
                 Some(g) => t.gas = g as u32,
                 None => {

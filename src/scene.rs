@@ -139,6 +139,10 @@ pub struct SurfaceTensionDef {
     /// ΔT_s (K), F22 (21): in heat scenes whose liquid melts, the force and each
     /// curvature neighbour ramp from 0 at the solidus to 1 at solidus + ΔT_s.
     pub melting_width: Option<f64>,
+    /// Static contact angle θ0 (degrees) of the liquid on every wall and solid
+    /// phase: wetting by a prescribed normal, F22 (27)–(29) (F22 form only).
+    /// Absent: no wetting model.
+    pub contact_angle: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -533,6 +537,8 @@ pub enum CheckKind {
     /// A 2D drop (a square at the start) relaxed to a disc: the spread of its
     /// outline's radius over 32 sectors, in Δx.
     DropShape,
+    /// A 2D sessile drop on the y_min wall settles at its static contact angle.
+    ContactAngle,
 }
 
 impl CheckKind {
@@ -554,6 +560,7 @@ impl CheckKind {
             CheckKind::Laplace => "laplace",
             CheckKind::RecoilImpulse => "recoil_impulse",
             CheckKind::DropShape => "drop_shape",
+            CheckKind::ContactAngle => "contact_angle",
         }
     }
 }

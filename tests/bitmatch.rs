@@ -352,3 +352,14 @@ fn line_melt_with_every_force_200_steps() {
     ];
     assert_bit_identical_at(&path, &sets, 200);
 }
+
+/// Issue 16 item 3: wetting by a prescribed normal (F22 (27)–(29)), the sessile
+/// drop at 60° spreading on its wall, 200 steps.
+#[test]
+fn wetting_sessile_drop_200_steps() {
+    assert_bit_identical(
+        "sessile_drop_2d",
+        &["surface_tension.contact_angle=60.0"],
+        200,
+    );
+}

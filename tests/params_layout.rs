@@ -197,6 +197,7 @@ fn flag_and_code_constants_match() {
         ("FLAG_SURFACE_TENSION", rs::FLAG_SURFACE_TENSION),
         ("FLAG_RECOIL", rs::FLAG_RECOIL),
         ("FLAG_FREE_SURFACE_TENSION", rs::FLAG_FREE_SURFACE_TENSION),
+        ("FLAG_WETTING", rs::FLAG_WETTING),
         ("NO_PHASE", rs::NO_PHASE),
         ("KIND_LIQUID", rs::KIND_LIQUID),
         ("KIND_GAS", rs::KIND_GAS),

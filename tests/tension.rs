@@ -8,6 +8,11 @@ fn run_laplace(sets: &[&str]) -> (f64, String) {
 }
 
 fn run_laplace_scene(name: &str, sets: &[&str]) -> (f64, String) {
+    run_check(name, sets, "check laplace:")
+}
+
+/// Run scene `name` on the CPU; the value of the check line starting `prefix`.
+fn run_check(name: &str, sets: &[&str], prefix: &str) -> (f64, String) {
     let scene = common::scene(name);
     let mut args = vec!["run", scene.as_str(), "--backend", "cpu"];
     for s in sets {
@@ -21,7 +26,7 @@ fn run_laplace_scene(name: &str, sets: &[&str]) -> (f64, String) {
     );
     let line = stdout
         .lines()
-        .find(|l| l.starts_with("check laplace:"))
+        .find(|l| l.starts_with(prefix))
         .unwrap_or_else(|| panic!("no check line: {stdout}"));
     let error: f64 = line
         .split(" = ")
@@ -145,9 +150,23 @@ fn bad_surface_tension_input_names_the_key() {
             "surface_tension.melting_width",
         ),
         ("surface_tension.smoothing=1.0", "smoothing"),
+        (
+            "surface_tension.contact_angle=180.0",
+            "surface_tension.contact_angle",
+        ),
     ] {
         common::assert_input_error(&["validate", &scene, "--set", set], key);
     }
+    // Wetting prescribes the liquid–gas normal: F22's form only.
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene("laplace_free_disc_2d"),
+            "--set",
+            "surface_tension.contact_angle=60.0",
+        ],
+        "surface_tension.contact_angle",
+    );
 }
 
 /// Recoil momentum balance (recoil_layer_2d): a free layer with its top above
@@ -305,4 +324,31 @@ fn laplace_sphere_3d_within_5_percent_at_10_dx() {
         stdout.contains("check laplace:") && stdout.contains("PASS"),
         "{stdout}"
     );
+}
+
+fn contact_angle(sets: &[&str]) -> (f64, String) {
+    let (error, out) = run_check("sessile_drop_2d", sets, "check contact_angle:");
+    (error, out)
+}
+
+/// Sessile drops settle at their static contact angle within 5° (the issue),
+/// at R ≈ 10Δx: 90° measured 86.2° (1.5 s), 60° measured 63.3° (3 s: it spreads
+/// slowly).
+#[test]
+fn sessile_drops_at_60_and_90_degrees_within_5() {
+    let (error, out) = contact_angle(&[]);
+    assert!(error <= 5.0, "{out}");
+    let (error, out) = contact_angle(&["surface_tension.contact_angle=60.0", "end_time=3.0"]);
+    assert!(error <= 5.0, "{out}");
+}
+
+/// 120° within 5°: not met at R ≈ 10Δx, measured 106.6° after 3 s (109.3° at
+/// 1.5 s): the drop beads up but stops short, a bias towards 90° that the 60°
+/// and 90° drops show too (63.3°, 85.4°). At Δx = 1 mm (R ≈ 20Δx, 2 s, 7 min)
+/// 113.7°: the gap halves with Δx. See the note on issue 16.
+#[test]
+#[ignore = "contact angle 106.6 deg for 120 (issue asks within 5 deg) at R = 10 dx; see the note on issue 16"]
+fn sessile_drop_at_120_degrees_within_5() {
+    let (error, out) = contact_angle(&["surface_tension.contact_angle=120.0", "end_time=3.0"]);
+    assert!(error <= 5.0, "{out}");
 }

@@ -63,8 +63,8 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     liquid: u32,
     gas: u32,                // NO_PHASE in the free-surface form
     kappa_max: f32,          // free-surface form: |kappa| <= 1/support
-    pad3: u32,
-    pad1: u32,
+    cos_contact: f32,        // F22 (27): cos, sin of the contact angle (FLAG_WETTING)
+    sin_contact: f32,
     pad2: u32,
 }
 
@@ -208,6 +208,7 @@ const FLAG_GAS_INTERFACE: u32 = 128u;
 const FLAG_SURFACE_TENSION: u32 = 256u;
 const FLAG_RECOIL: u32 = 512u;
 const FLAG_FREE_SURFACE_TENSION: u32 = 1024u;
+const FLAG_WETTING: u32 = 2048u;
 const NO_PHASE: u32 = 4294967295u;
 const KIND_LIQUID: u32 = 0u;
 const KIND_GAS: u32 = 1u;

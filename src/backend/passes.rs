@@ -6,7 +6,7 @@
 use super::cpu::CpuBackend;
 use crate::params::{
     Params, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL,
-    FLAG_SURFACE_TENSION, LASER_BEER_LAMBERT, LASER_SURFACE,
+    FLAG_SURFACE_TENSION, FLAG_WETTING, LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -93,6 +93,8 @@ pub struct Features {
     pub surface_tension: bool,
     /// Its free-surface form (R18): the curvature is smoothed in a second dispatch.
     pub free_surface_tension: bool,
+    /// F22 (27)–(29) wetting: the interface pass prescribes the normal near solids.
+    pub wetting: bool,
     /// F22 (30) recoil pressure.
     pub recoil: bool,
 }
@@ -113,6 +115,7 @@ impl Features {
             laser_surface: params.laser.model == LASER_SURFACE,
             surface_tension: params.flag(FLAG_SURFACE_TENSION),
             free_surface_tension: params.flag(FLAG_FREE_SURFACE_TENSION),
+            wetting: params.flag(FLAG_WETTING),
             recoil: params.flag(FLAG_RECOIL),
         }
     }
@@ -210,6 +213,11 @@ pub const STAGES: [StageDef; 12] = [
                 when: |f| !f.gas_interface,
             },
             always("normals", Work::Particles),
+            Dispatch {
+                entry: "wetting",
+                work: Work::Particles,
+                when: |f| f.wetting,
+            },
         ],
         cpu: |b| b.interface(),
     },
@@ -359,6 +367,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 23);
+        assert_eq!(e.len(), 25);
     }
 }

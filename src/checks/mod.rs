@@ -126,6 +126,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Laplace => Box::new(tension::Laplace::new(m, c)),
         CheckKind::RecoilImpulse => Box::new(tension::RecoilImpulse::new(c)),
         CheckKind::DropShape => Box::new(tension::DropShape::default()),
+        CheckKind::ContactAngle => Box::new(tension::ContactAngle::default()),
         CheckKind::Conduction1d => Box::new(heat::Conduction1d),
         CheckKind::ConductionTwoMaterials => Box::new(heat::TwoMaterials {
             interface: c.surface.unwrap_or(f64::NAN),

@@ -305,3 +305,75 @@ impl Check for DropShape {
         }
     }
 }
+
+/// A 2D sessile drop on the y_min wall settles at its static contact angle θ0
+/// (`surface_tension.contact_angle`): from the cap's height h (highest liquid
+/// particle + ½Δx above the wall face) and base width w (the extent of the
+/// bottom row of liquid + Δx), a circular cap has θ = 2 atan(2h/w). The verdict
+/// is |θ − θ0| in degrees, θ averaged over the samples of the run's second half.
+#[derive(Default)]
+pub struct ContactAngle {
+    /// (time, θ in degrees, h, w).
+    samples: Vec<(f64, f64, f64, f64)>,
+}
+
+impl Check for ContactAngle {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let floor = m.domain_lo[1];
+        let liquid: Vec<[f64; 3]> = particles(m, st)
+            .filter(|p| p.kind == PhaseKind::Liquid)
+            .map(|p| p.x)
+            .collect();
+        let top = liquid
+            .iter()
+            .map(|x| x[1])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let bottom: Vec<f64> = liquid
+            .iter()
+            .filter(|x| x[1] < floor + m.dx)
+            .map(|x| x[0])
+            .collect();
+        if bottom.is_empty() {
+            return;
+        }
+        let lo = bottom.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = bottom.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let (h, w) = (top + 0.5 * m.dx - floor, hi - lo + m.dx);
+        let theta = 2.0 * (2.0 * h / w).atan();
+        self.samples
+            .push((st.sim.time as f64, theta.to_degrees(), h, w));
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let metric =
+            "|contact angle - static angle| over the run's second half, degrees".to_string();
+        let target = m
+            .surface_tension
+            .as_ref()
+            .and_then(|s| s.contact_angle)
+            .map_or(f64::NAN, f64::to_degrees);
+        let end = st.sim.time as f64;
+        let late: Vec<_> = self.samples.iter().filter(|s| s.0 >= 0.5 * end).collect();
+        if late.is_empty() {
+            return (
+                metric,
+                f64::NAN,
+                vec!["  no sample with a drop on the wall".into()],
+            )
+                .into();
+        }
+        let k = late.len() as f64;
+        let theta = late.iter().map(|s| s.1).sum::<f64>() / k;
+        let h = late.iter().map(|s| s.2).sum::<f64>() / k;
+        let w = late.iter().map(|s| s.3).sum::<f64>() / k;
+        Verdict {
+            metric,
+            value: (theta - target).abs(),
+            details: vec![format!(
+                "  contact angle {theta:.2} deg against {target:.1} deg (cap height {h:.4e} m, base width {w:.4e} m, mean of {} samples)",
+                late.len()
+            )],
+            figures: vec![("contact_angle_deg".into(), theta)],
+        }
+    }
+}

@@ -410,6 +410,17 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 "\"drop_shape\" needs a 2D scene with [surface_tension] of constant coefficient",
             ));
         }
+        if c.kind == crate::scene::CheckKind::ContactAngle
+            && (dim != 2
+                || !surface_tension
+                    .as_ref()
+                    .is_some_and(|s| s.contact_angle.is_some()))
+        {
+            return Err(cx.err(
+                "check.kind",
+                "\"contact_angle\" needs a 2D scene with surface_tension.contact_angle",
+            ));
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;

@@ -19,6 +19,8 @@ pub struct SurfaceTension {
     /// (T_m, ΔT_s): the liquid's solidus and the ramp width above it, in heat
     /// scenes whose liquid melts; None: no regularisation (f = 1).
     pub ramp: Option<(f64, f64)>,
+    /// F22 (27)–(29) static contact angle on walls and solids, radians.
+    pub contact_angle: Option<f64>,
 }
 
 impl SurfaceTension {
@@ -123,7 +125,26 @@ pub(super) fn surface_tension(
         }
         (None, None) => None,
     };
+    let contact_angle = match d.contact_angle {
+        None => None,
+        Some(a) => {
+            if !(a.is_finite() && a > 0.0 && a < 180.0) {
+                return Err(cx.err(
+                    "surface_tension.contact_angle",
+                    format!("must lie strictly between 0 and 180 degrees, got {a}"),
+                ));
+            }
+            if gas.is_none() {
+                return Err(cx.err(
+                    "surface_tension.contact_angle",
+                    "wetting (F22 (27)-(29)) prescribes the liquid-gas normal: it needs F22's form with a gas phase",
+                ));
+            }
+            Some(a.to_radians())
+        }
+    };
     Ok(Some(SurfaceTension {
+        contact_angle,
         liquid,
         gas,
         coefficient,

@@ -23,7 +23,7 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
+use crate::params::{Params, FLAG_GAS_INTERFACE, FLAG_WETTING, KIND_GAS};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -99,6 +99,78 @@ fn density(pr: &Params, st: &State, j: usize) -> f32 {
     }
 }
 
+/// F22's χ_j of a wall or solid neighbour for the solid colour field: f̄[T_j,
+/// T_m − ΔT_s, T_m] for a conducting (solid) particle in a scene with the
+/// tension ramp, 1 otherwise (walls, isothermal scenes).
+#[inline(always)]
+#[allow(clippy::manual_clamp)]
+fn solid_weight(pr: &Params, st: &State, j: usize) -> f32 {
+    let t = &pr.tension;
+    if t.inv_ramp_width == 0.0 || !pr.conducts(st.phase[j]) {
+        return 1.0;
+    }
+    1.0 - ((st.heat[j][1] - t.t_melt) * t.inv_ramp_width + 1.0)
+        .max(0.0)
+        .min(1.0)
+}
+
+/// Wetting by a prescribed normal, F22 (27)–(29), for a particle i of the
+/// tension pair with the standard normal ñ (`n`): the solid colour c^sf = Σ_j V_j
+/// χ_j W_ij and its gradient Σ_j V_j χ_j ∇_iW_ij over wall and solid neighbours
+/// (V = m/ρ0) give n^sf (towards the solid; kept ñ where |∇c^sf| ≤ 0.1/h); the
+/// tangent t = ñ − (ñ·n^sf) n^sf normalised (PAPERS-EXTRACT §1.5: F22 (28)
+/// prints n̂ there, which is circular), n̂ = t sin θ − n^sf cos θ with θ = θ0 for
+/// the liquid and π − θ0 for the gas (its normal points the other way), and
+/// n = normalise(f n̂ + (1 − f) ñ), f = f[c^sf, 0, 0.2] (F22's c1, c2); δ kept.
+fn wet(pr: &Params, st: &State, grid: &CellTable, i: usize, n: [f32; 4]) -> [f32; 4] {
+    let (mut c, mut g) = (0.0f32, [0.0f32; 3]);
+    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
+        let ph = st.phase[j];
+        if r2 <= 0.0 || !pr.is_wall(ph) {
+            return;
+        }
+        let r = r2.sqrt();
+        let v = st.mass[j] / pr.phase(ph).rho0 * solid_weight(pr, st, j);
+        c += v * kernel::w(pr, r);
+        let f = v * kernel::dw(pr, r) / r;
+        for a in 0..3 {
+            g[a] += f * d[a];
+        }
+    });
+    let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    if gl <= 0.1 * pr.kernel.inv_h {
+        return n;
+    }
+    let ns = [g[0] / gl, g[1] / gl, g[2] / gl];
+    let nn = n[0] * ns[0] + n[1] * ns[1] + n[2] * ns[2];
+    let mut t = [n[0] - nn * ns[0], n[1] - nn * ns[1], n[2] - nn * ns[2]];
+    let tl = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+    t = if tl > 1e-6 {
+        [t[0] / tl, t[1] / tl, t[2] / tl]
+    } else {
+        [0.0; 3]
+    };
+    let tension = &pr.tension;
+    let (cos, sin) = if st.phase[i] == tension.liquid {
+        (tension.cos_contact, tension.sin_contact)
+    } else {
+        (-tension.cos_contact, tension.sin_contact)
+    };
+    #[allow(clippy::manual_clamp)]
+    let f = (c * 5.0).max(0.0).min(1.0);
+    let mut m = [0.0f32; 3];
+    for a in 0..3 {
+        let prescribed = t[a] * sin - ns[a] * cos;
+        m[a] = f * prescribed + (1.0 - f) * n[a];
+    }
+    let ml = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+    if ml > 1e-6 {
+        [m[0] / ml, m[1] / ml, m[2] / ml, n[3]]
+    } else {
+        [0.0, 0.0, 0.0, n[3]]
+    }
+}
+
 /// F22 (19)–(20) between condensed particles and gas particles.
 fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
     let n = st.active();
@@ -142,4 +214,19 @@ fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
         })
         .collect();
     st.surface[..n].copy_from_slice(&normals);
+    if pr.flag(FLAG_WETTING) {
+        let s: &State = st;
+        let wetted: Vec<[f32; 4]> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let ph = s.phase[i];
+                let n_i = s.surface[i];
+                if n_i[3] == 0.0 || (ph != pr.tension.liquid && ph != pr.tension.gas) {
+                    return n_i;
+                }
+                wet(pr, s, grid, i, n_i)
+            })
+            .collect();
+        st.surface[..n].copy_from_slice(&wetted);
+    }
 }

@@ -3,9 +3,9 @@
 // Forces at the interface, added to the acceleration the forces pass wrote:
 // surface_tension, CSF with Marangoni stress F22 (24)-(26), (8), (21) between the
 // liquid and the gas of P.tension (curvature kappa_i, Morris 2000 / F22 (25), to
-// surface[n + i].y), or in the free-surface form (FLAG_FREE_SURFACE_TENSION, R18
-// 3.1.1-3.1.2) its raw curvature (surface_tension) then the smoothed curvature and
-// force (tension_smooth); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
+// surface[n + i].y), or in the free-surface form (R18 3.1.1-3.1.2) its raw
+// curvature (tension_curvature) then the smoothed curvature and force
+// (tension_smooth); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
 // (equations and choices there).
 
 // F22 (21) f[T, T_m, T_m + dT_s]; 1 without a ramp.
@@ -47,10 +47,6 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     let i = thread_index(gid, nwg);
     if (i >= active_particles()) { return; }
     let n = P.sizes.n_particles;
-    if ((P.sizes.flags & FLAG_FREE_SURFACE_TENSION) != 0u) {
-        free_surface_curvature(i);
-        return;
-    }
     let ph_i = phase[i];
     if (!in_tension_pair(ph_i)) { return; }
     let liquid_i = ph_i == P.tension.liquid;
@@ -131,11 +127,14 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
     );
 }
 
-// Free-surface form, R18 (3.28)-(3.29): raw Morris curvature over the liquid's
-// particles with a normal, weights V delta (V = m / rho0), capped at
-// |kappa| <= 1/support; to
-// surface[n + i].z (the Shepard pass zeroed it for everyone else).
-fn free_surface_curvature(i: u32) {
+// Free-surface form, first dispatch, R18 (3.28)-(3.29): raw Morris curvature
+// over the liquid's particles with a normal, weights V delta (V = m / rho0),
+// capped at |kappa| <= 1/support; to surface[n + i].z (the Shepard pass zeroed
+// it for everyone else).
+@compute @workgroup_size(64)
+fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
     let n = P.sizes.n_particles;
     let liquid = P.tension.liquid;
     let s_i = surface[i];

@@ -160,6 +160,7 @@ impl Outputs {
         }
         Ok(())
     }
+    /// `track` has observed `st` already (its depression under the beam).
     fn diagnostics(&mut self, m: &Model, st: &State, track: Option<&Track>) -> Result<(), String> {
         if self.last_diag_step == Some(st.sim.step) {
             return Ok(());
@@ -169,7 +170,7 @@ impl Outputs {
             Some(s) => {
                 s.removals(m, st)?;
                 let mut d = output::diagnostics(m, st);
-                d.depression_depth = track.and_then(|t| t.depression(m, st));
+                d.depression_depth = track.and_then(Track::depression_now);
                 s.diagnostics(&d)
             }
             None => Ok(()),
@@ -416,6 +417,9 @@ pub fn run(
             let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
             leakage.absorb(watchdog::leakage(m, &bad));
+            if let Some(t) = track.as_mut() {
+                t.observe(m, &bad);
+            }
             out.frame(m, &bad).map_err(rt)?;
             out.diagnostics(m, &bad, track.as_ref()).map_err(rt)?;
             out.checkpoint(m, &good).map_err(rt)?;
@@ -425,6 +429,9 @@ pub fn run(
         None => {
             let fin = fin.expect("the final state is read when nothing tripped");
             leakage.absorb(watchdog::leakage(m, &fin));
+            if let Some(t) = track.as_mut() {
+                t.observe(m, &fin);
+            }
             out.frame(m, &fin).map_err(rt)?;
             out.diagnostics(m, &fin, track.as_ref()).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
@@ -433,10 +440,7 @@ pub fn run(
             fin
         }
     };
-    let track = track.map(|mut t| {
-        t.observe(m, &final_state);
-        t.finish(m, &final_state)
-    });
+    let track = track.map(|t| t.finish(m, &final_state));
     if let (Some(sink), Some(profile)) = (out.mcap.as_mut(), track.as_ref()) {
         sink.track(final_state.sim.time as f64, profile)
             .map_err(rt)?;

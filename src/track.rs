@@ -39,6 +39,8 @@ pub struct Track {
     lowest_melt: Vec<f64>,
     melt_y: Vec<[f64; 2]>,
     peak_t: Vec<f64>,
+    /// The depression under the beam at the last state observed.
+    depression_now: Option<f64>,
     pub pool: PoolPeaks,
 }
 
@@ -110,6 +112,7 @@ impl Track {
             lowest_melt: vec![f64::INFINITY; slices],
             melt_y: vec![[f64::INFINITY, f64::NEG_INFINITY]; slices],
             peak_t: vec![f64::NEG_INFINITY; slices],
+            depression_now: None,
             pool: PoolPeaks::default(),
         };
         for i in 0..st.active() {
@@ -165,7 +168,8 @@ impl Track {
                 self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
             }
         }
-        if let Some(d) = self.depression(m, st) {
+        self.depression_now = self.depression(m, st);
+        if let Some(d) = self.depression_now {
             if d > self.pool.max_depression {
                 self.pool.max_depression = d;
                 self.pool.max_depression_time = time;
@@ -189,11 +193,16 @@ impl Track {
         }
     }
 
+    /// The depression under the beam at the state last observed (`/diagnostics`).
+    pub fn depression_now(&self) -> Option<f64> {
+        self.depression_now
+    }
+
     /// Depth of the surface under the beam below the initial surface (m; > 0:
     /// sunk): the column top of the slice under the beam centre (on the beam line
     /// in 3D), as `finish` reads it. None while the beam is outside the slices or
     /// the column is empty.
-    pub fn depression(&self, m: &Model, st: &State) -> Option<f64> {
+    fn depression(&self, m: &Model, st: &State) -> Option<f64> {
         let laser = m.laser.as_ref()?;
         let c = laser.centre_at(st.sim.time as f64);
         let k = ((c[0] - self.x0) / self.dx).floor();
@@ -208,29 +217,6 @@ impl Track {
             .collect();
         let top = column_top(&mut zs, self.dx)? + 0.5 * self.dx;
         Some(self.initial_top[k] - top)
-    }
-
-    /// The hottest condensed particle within the beam radius of its centre
-    /// (laterally), K.
-    pub fn beam_temperature(&self, m: &Model, st: &State) -> f64 {
-        let Some(laser) = m.laser.as_ref() else {
-            return f64::NAN;
-        };
-        let c = laser.centre_at(st.sim.time as f64);
-        let mut hottest = f64::NEG_INFINITY;
-        for i in 0..st.active() {
-            if !condensed(m, st, i) {
-                continue;
-            }
-            let mut d2 = 0.0;
-            for a in 0..m.dim as usize - 1 {
-                d2 += (world_coord(m, st, i, a) as f64 - c[a]).powi(2);
-            }
-            if d2 <= laser.radius * laser.radius {
-                hottest = hottest.max(st.heat[i][1] as f64);
-            }
-        }
-        hottest
     }
 
     /// The profile from the final state (the resolidified surface).
@@ -282,12 +268,11 @@ impl Track {
 /// while each next one is within 1.5Δx.
 fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
     zs.sort_by(|a, b| a.total_cmp(b));
-    let first = *zs.first()?;
+    let last = *zs.last()?;
     Some(
         zs.windows(2)
             .find(|w| w[1] - w[0] > 1.5 * dx)
-            .map_or(zs[zs.len() - 1], |w| w[0])
-            .max(first),
+            .map_or(last, |w| w[0]),
     )
 }
 

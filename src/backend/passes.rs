@@ -238,7 +238,12 @@ pub const STAGES: [StageDef; 12] = [
             Dispatch {
                 entry: "surface_tension",
                 work: Work::Particles,
-                when: |f| f.surface_tension,
+                when: |f| f.surface_tension && !f.free_surface_tension,
+            },
+            Dispatch {
+                entry: "tension_curvature",
+                work: Work::Particles,
+                when: |f| f.free_surface_tension,
             },
             Dispatch {
                 entry: "tension_smooth",
@@ -367,6 +372,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 25);
+        assert_eq!(e.len(), 26);
     }
 }

@@ -327,8 +327,7 @@ pub fn rosenthal(m: &Model, st: &State) -> (String, f64, Vec<String>) {
     let (t0, p0) = l.path[n - 2];
     let (t1, p1) = l.path[n - 1];
     let v = (p1[0] - p0[0]) / (t1 - t0);
-    let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-    let beam = [p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1])];
+    let beam = l.centre_at(t);
     let q = l.absorptivity * l.power_at(t);
     let up = m.dim as usize - 1;
     let top = m.domain_hi[up];

@@ -87,8 +87,8 @@ impl CpuBackend {
     pub(crate) fn surface_forces(&mut self) {
         let f = self.pipeline.features;
         if f.free_surface_tension {
-            surface_forces::free_surface_curvature(&self.params, &mut self.st, &self.grid);
-            surface_forces::free_surface_tension(&self.params, &mut self.st, &self.grid);
+            surface_forces::tension_curvature(&self.params, &mut self.st, &self.grid);
+            surface_forces::tension_smooth(&self.params, &mut self.st, &self.grid);
         } else if f.surface_tension {
             surface_forces::surface_tension(&self.params, &mut self.st, &self.grid);
         }

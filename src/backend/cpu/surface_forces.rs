@@ -42,6 +42,22 @@ fn ramp(pr: &Params, t: f32) -> f32 {
     ((t - s.t_melt) * s.inv_ramp_width).max(0.0).min(1.0)
 }
 
+/// Temperature of particle j (0 in scenes without heat).
+#[inline(always)]
+fn temperature(pr: &Params, st: &State, j: usize) -> f32 {
+    if pr.flag(FLAG_HEAT) {
+        st.heat[j][1]
+    } else {
+        0.0
+    }
+}
+
+/// Carries a temperature for ∇T (F22 (26)): conducting, or a Dirichlet wall.
+#[inline(always)]
+fn has_temperature(pr: &Params, ph: u32) -> bool {
+    pr.conducts(ph) || (pr.flag(FLAG_HEAT) && pr.heat_flags(ph) & HEAT_DIRICHLET != 0)
+}
+
 #[inline(always)]
 fn in_pair(pr: &Params, ph: u32) -> bool {
     ph == pr.tension.liquid || ph == pr.tension.gas
@@ -51,9 +67,8 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
     let heated = pr.flag(FLAG_HEAT);
     let s: &State = st;
-    let temperature = |j: usize| if heated { s.heat[j][1] } else { 0.0 };
-    let has_temperature =
-        |ph: u32| pr.conducts(ph) || (heated && pr.heat_flags(ph) & HEAT_DIRICHLET != 0);
+    let temperature = |j: usize| temperature(pr, s, j);
+    let has_temperature = |ph: u32| has_temperature(pr, ph);
     let volume = |j: usize| {
         let ph = s.phase[j];
         if pr.is_wall(ph) {
@@ -138,14 +153,12 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
 /// their κ spread into the surface row through the smoothing (Laplace jump at
 /// R = 20Δx +459% with the mask, +285% with δ; +206% and +211% at 10Δx: neither
 /// is right, see laplace_free_disc_2d and the note on issue 16).
-pub fn free_surface_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
-    let heated = pr.flag(FLAG_HEAT);
     let s: &State = st;
     let liquid = pr.tension.liquid;
     let weight = |j: usize| {
-        let t = if heated { s.heat[j][1] } else { 0.0 };
-        ramp(pr, t) * (s.mass[j] / pr.phase(liquid).rho0) * s.surface[j][3]
+        ramp(pr, temperature(pr, s, j)) * (s.mass[j] / pr.phase(liquid).rho0) * s.surface[j][3]
     };
     let kmax = pr.tension.kappa_max;
     let kappa: Vec<f32> = (0..active)
@@ -187,15 +200,14 @@ pub fn free_surface_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
 /// / Σ_j V_j W_ij over the neighbours with a temperature (the missing outside
 /// would bias the plain sum at the surface); then F22 (24)'s force, as in the gas
 /// form, a_i = f[T_i] δ_i (α'_i ∇_t T_i − α_i κ_i n_i)/ρ0 (R18 (3.31), (3.35)).
-pub fn free_surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
     let heated = pr.flag(FLAG_HEAT);
     let s: &State = st;
     let liquid = pr.tension.liquid;
     let rho0 = pr.phase(liquid).rho0;
-    let temperature = |j: usize| if heated { s.heat[j][1] } else { 0.0 };
-    let has_temperature =
-        |ph: u32| pr.conducts(ph) || (heated && pr.heat_flags(ph) & HEAT_DIRICHLET != 0);
+    let temperature = |j: usize| temperature(pr, s, j);
+    let has_temperature = |ph: u32| has_temperature(pr, ph);
     let volume = |j: usize| s.mass[j] / pr.phase(s.phase[j]).rho0;
     let out: Vec<Option<([f32; 3], f32)>> = (0..active)
         .into_par_iter()

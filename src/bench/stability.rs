@@ -45,6 +45,10 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/dam_break_gate_2d"), &["dx=0.01"]),
     (scene_file!("validation/hydrostatic_2d"), &["dx=0.025"]),
     (scene_file!("validation/hydrostatic_3d"), &["dx=0.025"]),
+    (scene_file!("validation/jet_outflow_2d"), &[]),
+    (scene_file!("validation/laplace_disc_2d"), &["dx=2e-3"]),
+    (scene_file!("validation/laplace_free_disc_2d"), &["dx=2e-3"]),
+    (scene_file!("validation/laplace_sphere_3d"), &["dx=4e-3"]),
     (scene_file!("validation/laser_flat_plate"), &["dx=2e-5"]),
     (
         scene_file!("validation/laser_plate_under_gas_2d"),
@@ -55,7 +59,10 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         scene_file!("validation/poiseuille_2d"),
         &["dx=6.666666666666667e-5"],
     ),
+    (scene_file!("validation/recoil_layer_2d"), &[]),
     (scene_file!("validation/rosenthal_2d"), &["dx=5e-5"]),
+    (scene_file!("validation/sessile_drop_2d"), &[]),
+    (scene_file!("validation/square_drop_2d"), &["dx=4e-3"]),
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),
     (scene_file!("validation/two_layer_2d"), &["dx=0.01"]),
     (
@@ -67,6 +74,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=0.025"],
     ),
     (scene_file!("pbf/line_melt_bare_plate"), &["dx=2e-5"]),
+    (scene_file!("pbf/line_melt_coarse_2d"), &[]),
 ];
 
 /// The long runs `--quick` keeps (one per kind of physics).
@@ -636,4 +644,26 @@ pub fn stability(opts: &Options) -> Result<bool, SpatterError> {
         println!("{crashed} case(s) crashed: each is a bug");
     }
     Ok(crashed == 0)
+}
+
+#[cfg(test)]
+mod every_scene {
+    use super::LONG_RUNS;
+
+    /// "Long runs of every validation and process scene": each scene file under
+    /// scenarios/validation and scenarios/pbf has a LONG_RUNS row.
+    #[test]
+    fn every_validation_and_process_scene_has_a_long_run() {
+        for dir in ["validation", "pbf"] {
+            let path = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
+            for entry in std::fs::read_dir(&path).unwrap() {
+                let name = entry.unwrap().file_name().into_string().unwrap();
+                let label = format!("scenarios/{dir}/{name}");
+                assert!(
+                    LONG_RUNS.iter().any(|((l, _), _)| *l == label),
+                    "{label} has no LONG_RUNS row"
+                );
+            }
+        }
+    }
 }

@@ -43,9 +43,10 @@ const SCENES: [BenchScene; 2] = [
 
 /// Stages a scene may or may not have: the ones whose cost is measured by leaving
 /// them out.
-const OPTIONAL: [Stage; 5] = [
+const OPTIONAL: [Stage; 6] = [
     Stage::Wall,
     Stage::Interface,
+    Stage::SurfaceForces,
     Stage::Laser,
     Stage::Heat,
     Stage::Temperature,

@@ -18,7 +18,8 @@ fn heat_density(ph: u32, i: u32) -> f32 {
     return rho[i];
 }
 
-// Dirichlet wall particles: T = 2 T_wall - (Shepard mean of conducting neighbours).
+// Dirichlet wall particles: T = 2 T_wall - (Shepard mean of conducting neighbours),
+// T_wall the particle's own fixed temperature (heat.x).
 @compute @workgroup_size(64)
 fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -38,8 +39,8 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
             stw = stw + heat[j].y * wk;
         }
     }
-    let t_wall = P.phases[ph].fixed_temperature;
     var hv = heat[i];
+    let t_wall = hv.x;
     if (sw > 0.0) {
         hv.y = c_two() * t_wall - stw / sw;
     } else {

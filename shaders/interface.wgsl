@@ -100,6 +100,8 @@ fn solid_weight(j: u32) -> f32 {
 // dispatch rewrites surface[i] in place.
 fn wet(i: u32, n: vec4<f32>) -> vec4<f32> {
     var c = 0.0;
+    var cw = 0.0;
+    var sw = 0.0;
     var g = vec3<f32>(0.0, 0.0, 0.0);
     let pi = pos[i];
     let ci = cell_coord(pi);
@@ -111,7 +113,10 @@ fn wet(i: u32, n: vec4<f32>) -> vec4<f32> {
         if (r2 >= P.kernel.support2 || r2 <= 0.0 || !is_wall(ph)) { continue; }
         let r = sqrt(r2);
         let v = mass[j] / P.phases[ph].rho0 * solid_weight(j);
-        c = c + v * kernel_w(r);
+        let wv = v * kernel_w(r);
+        c = c + wv;
+        cw = cw + wv * P.phases[ph].contact_cos;
+        sw = sw + wv * P.phases[ph].contact_sin;
         let f = v * kernel_dw(r) / r;
         g.x = g.x + f * d.x;
         g.y = g.y + f * d.y;
@@ -130,8 +135,12 @@ fn wet(i: u32, n: vec4<f32>) -> vec4<f32> {
     } else {
         t = vec3<f32>(0.0, 0.0, 0.0);
     }
-    var cs = P.tension.cos_contact;
-    let sn = P.tension.sin_contact;
+    let al = sqrt(cw * cw + sw * sw);
+    if (al <= 0.0) {
+        return n;
+    }
+    var cs = cw / al;
+    let sn = sw / al;
     if (phase[i] != P.tension.liquid) {
         cs = -cs;
     }

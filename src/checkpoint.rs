@@ -17,7 +17,9 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"SPATCKPT";
-const FORMAT_VERSION: u32 = 1;
+// 2: a Dirichlet wall particle's fixed temperature is its heat.x (was 0; version 1
+// files would resume with 0 K walls).
+const FORMAT_VERSION: u32 = 2;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
 const KEEP: usize = 2;

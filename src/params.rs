@@ -185,9 +185,8 @@ gpu_struct! {
         pub gas: u32,
         /// Free-surface form: |κ| ≤ 1/support (R18's cap 1/(2h) of Wendland); 0 otherwise.
         pub kappa_max: f32,
-        /// cos θ0, sin θ0 of the static contact angle (FLAG_WETTING).
-        pub cos_contact: f32,
-        pub sin_contact: f32,
+        pub pad0: f32,
+        pub pad1: f32,
         pub pad2: u32,
     }
 }
@@ -298,9 +297,11 @@ gpu_struct! {
         pub recondensation: f32,
         /// ε σ_B (radiation).
         pub emissivity_sb: f32,
-        /// A Dirichlet wall's fixed temperature.
-        pub fixed_temperature: f32,
-        pub pad0: f32,
+        /// cos θ0, sin θ0 of the liquid's static contact angle on this wall or
+        /// solid phase (FLAG_WETTING; F22 (27)). (A Dirichlet wall particle's
+        /// fixed temperature is its own, in heat.x.)
+        pub contact_cos: f32,
+        pub contact_sin: f32,
         pub pad1: f32,
         pub pad2: f32,
     }
@@ -507,10 +508,14 @@ impl Params {
                 t.inv_ramp_width = (1.0 / width) as f32;
             }
             t.liquid = s.liquid as u32;
-            if let Some(theta) = s.contact_angle {
+            if let Some(angles) = &s.contact_angle {
                 p.sizes.flags |= FLAG_WETTING;
-                t.cos_contact = theta.cos() as f32;
-                t.sin_contact = theta.sin() as f32;
+                for (k, theta) in angles.iter().enumerate() {
+                    if let Some(theta) = theta {
+                        p.phases[k].contact_cos = theta.cos() as f32;
+                        p.phases[k].contact_sin = theta.sin() as f32;
+                    }
+                }
             }
             match s.gas {
                 Some(g) => t.gas = g as u32,
@@ -815,7 +820,6 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
     let Some(t) = ph.thermal else { return b };
     if ph.kind == PhaseKind::Wall {
         b.flags |= HEAT_DIRICHLET;
-        b.fixed_temperature = t.temperature as f32;
     }
     if ph.is_fluid() {
         b.flags |= HEAT_LIQUID;

@@ -139,10 +139,19 @@ pub struct SurfaceTensionDef {
     /// ΔT_s (K), F22 (21): in heat scenes whose liquid melts, the force and each
     /// curvature neighbour ramp from 0 at the solidus to 1 at solidus + ΔT_s.
     pub melting_width: Option<f64>,
-    /// Static contact angle θ0 (degrees) of the liquid on every wall and solid
-    /// phase: wetting by a prescribed normal, F22 (27)–(29) (F22 form only).
-    /// Absent: no wetting model.
-    pub contact_angle: Option<f64>,
+    /// Static contact angle θ0 (degrees) of the liquid on the wall and solid
+    /// phases: wetting by a prescribed normal, F22 (27)–(29) (F22 form only).
+    /// One number for all of them, or a table naming every wall and solid phase
+    /// (`{ substrate = 60.0, wall = 90.0 }`). Absent: no wetting model.
+    pub contact_angle: Option<ContactAngleDef>,
+}
+
+/// `surface_tension.contact_angle`: one angle, or one per wall and solid phase.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum ContactAngleDef {
+    All(f64),
+    PerPhase(std::collections::BTreeMap<String, f64>),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -381,10 +390,26 @@ pub struct PhaseDef {
     /// on a wall phase it is a fixed (Dirichlet) temperature, and a wall phase
     /// without one is adiabatic.
     pub temperature: Option<f64>,
+    /// A cosine added to `temperature` along one axis, T = temperature + amplitude
+    /// cos(2π x_axis / wavelength): a wall heated periodically (the thermocapillary
+    /// channel of Pendse & Esmaeeli 2010), or an initial temperature field.
+    pub temperature_wave: Option<TemperatureWaveDef>,
     /// Solid phases: the liquid phase a particle becomes when it melts (liquid
     /// fraction ≥ ½); it turns back into this solid, frozen in place, when it
     /// solidifies (F22 §3.2 with a fixed substrate).
     pub melts_into: Option<String>,
+}
+
+/// `phases.<name>.temperature_wave`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureWaveDef {
+    /// K; smaller than the phase's temperature (T stays positive).
+    pub amplitude: f64,
+    /// m.
+    pub wavelength: f64,
+    /// "x", "y" or "z".
+    pub axis: String,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -539,6 +564,9 @@ pub enum CheckKind {
     DropShape,
     /// A 2D sessile drop on the y_min wall settles at its static contact angle.
     ContactAngle,
+    /// Marangoni flow in a two-layer channel over a wall heated as a cosine
+    /// (Pendse & Esmaeeli 2010): the interface velocity against the Stokes solution.
+    Thermocapillary,
 }
 
 impl CheckKind {
@@ -561,6 +589,7 @@ impl CheckKind {
             CheckKind::RecoilImpulse => "recoil_impulse",
             CheckKind::DropShape => "drop_shape",
             CheckKind::ContactAngle => "contact_angle",
+            CheckKind::Thermocapillary => "thermocapillary",
         }
     }
 }

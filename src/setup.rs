@@ -384,21 +384,29 @@ fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
     st.phase.push(pi as u32);
     st.id.push(id);
     if m.is_thermal() {
-        st.heat.push(initial_heat(ph));
+        st.heat.push(initial_heat(ph, x));
     }
 }
 
-/// Enthalpy and temperature at setup. The heat.temperature pass recomputes T and
-/// f_l from h before the first step; a Dirichlet wall keeps its temperature.
-fn initial_heat(ph: &crate::model::PhaseInfo) -> [f32; 4] {
+/// Enthalpy and temperature at setup (x absolute). The heat.temperature pass
+/// recomputes T and f_l from h before the first step. A Dirichlet wall particle
+/// holds its fixed temperature in heat.x (it has no enthalpy), which the
+/// wall_temperature pass mirrors through the wall every step.
+fn initial_heat(ph: &crate::model::PhaseInfo, x: [f64; 3]) -> [f32; 4] {
     match ph.thermal {
-        Some(t) if ph.conducts() => [
-            (t.enthalpy(t.temperature) - t.reference_enthalpy()) as f32,
-            t.temperature as f32,
-            0.0,
-            0.0,
-        ],
-        Some(t) => [0.0, t.temperature as f32, 0.0, 0.0],
+        Some(t) if ph.conducts() => {
+            let temp = t.temperature_at(x);
+            [
+                (t.enthalpy(temp) - t.reference_enthalpy()) as f32,
+                temp as f32,
+                0.0,
+                0.0,
+            ]
+        }
+        Some(t) => {
+            let temp = t.temperature_at(x) as f32;
+            [temp, temp, 0.0, 0.0]
+        }
         None => [0.0; 4],
     }
 }

@@ -363,3 +363,39 @@ fn wetting_sessile_drop_200_steps() {
         200,
     );
 }
+
+/// Issue 16 item 8: the thermocapillary channel (Marangoni flow between a wall
+/// heated as a cosine and a cold one), 200 steps: every Dirichlet wall particle
+/// mirrors its own fixed temperature (heat.x), the Marangoni term along a flat
+/// interface, conduction through both fluids.
+#[test]
+fn thermocapillary_channel_200_steps() {
+    assert_bit_identical("thermocapillary_2d", &[], 200);
+}
+
+/// Per-phase contact angles: the sessile drop straddles two floor phases (60°
+/// on the left, 120° on the right), so the wetting pass averages the two
+/// angles' directions near the seam; 200 steps.
+#[test]
+fn wetting_two_floor_phases_200_steps() {
+    let full = std::fs::read_to_string(common::scene("sessile_drop_2d")).unwrap();
+    let text = full[..full.find("[check]").unwrap()]
+        .replace("min = [0.0, 0.0]\nmax = [0.12, 0.06]", "min = [0.0, -0.0061]\nmax = [0.12, 0.06]")
+        .replace(
+            "[[shapes]]\nphase = \"gas\"",
+            "[phases.patch]\nkind = \"wall\"\nmaterial = \"liquid\"\n\n\
+             [[shapes]]\nphase = \"substrate\"\nbox = { min = [0.0, -0.0061], max = [0.06, 0.0] }\n\n\
+             [[shapes]]\nphase = \"patch\"\nbox = { min = [0.06, -0.0061], max = [0.12, 0.0] }\n\n\
+             [[shapes]]\nphase = \"gas\"",
+        )
+        .replace(
+            "contact_angle = 90.0            # degrees",
+            "contact_angle = { substrate = 60.0, patch = 120.0 }",
+        );
+    assert!(text.contains("patch = 120.0") && text.contains("max = [0.12, 0.0]"));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_wetting");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("two_floors.toml");
+    std::fs::write(&path, text).unwrap();
+    assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
+}

@@ -154,6 +154,10 @@ fn bad_surface_tension_input_names_the_key() {
             "surface_tension.contact_angle=180.0",
             "surface_tension.contact_angle",
         ),
+        (
+            "surface_tension.contact_angle={ gas = 60.0 }",
+            "surface_tension.contact_angle.gas",
+        ),
     ] {
         common::assert_input_error(&["validate", &scene, "--set", set], key);
     }
@@ -351,4 +355,101 @@ fn sessile_drops_at_60_and_90_degrees_within_5() {
 fn sessile_drop_at_120_degrees_within_5() {
     let (error, out) = contact_angle(&["surface_tension.contact_angle=120.0", "end_time=3.0"]);
     assert!(error <= 5.0, "{out}");
+}
+
+/// Thermocapillary channel (Pendse & Esmaeeli 2010, scenarios/validation/
+/// thermocapillary_2d.toml): the interface velocity profile (20 points per
+/// wavelength) within 5% of the analytic amplitude, the issue's tolerance, at
+/// a = 20Δx, and the error falling from a = 10Δx. Measured 8.97% at 10Δx, 4.49%
+/// at 20Δx (61 s on 2 cores): first order, the Marangoni stress acting over the
+/// liquid side's surface delta (liquid rows +27.6% / +14.4% fast, the second
+/// fluid's first row −15.5% / −6.2% slow). The issue asks the tolerance at the
+/// finest of three resolutions; `spatter bench accuracy --scene
+/// thermocapillary_2d` runs a = 10, 20, 40Δx.
+#[test]
+fn thermocapillary_interface_velocity_within_5_percent_and_converging() {
+    let prefix = "check thermocapillary:";
+    let (coarse, out_coarse) = run_check("thermocapillary_2d", &[], prefix);
+    let (fine, out) = run_check("thermocapillary_2d", &["dx=1.25e-5"], prefix);
+    assert!(fine <= 0.05, "{out}");
+    assert!(fine < 0.75 * coarse, "{out_coarse}{out}");
+    // Steady: the band's amplitude moved less than 1% of U over the last quarter.
+    let drift: f64 = out
+        .lines()
+        .find_map(|l| l.split("over the last quarter ").nth(1))
+        .and_then(|v| v.split('%').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(drift < 1.0, "{out}");
+}
+
+/// A wall heated as a cosine (`temperature_wave`) and the thermocapillary check's
+/// layout: bad input exits 2 naming the key.
+#[test]
+fn bad_temperature_wave_and_channel_input_names_the_key() {
+    let scene = common::scene("thermocapillary_2d");
+    let wave = "phases.hot_wall.temperature_wave";
+    for (set, key) in [
+        (
+            format!("{wave}.amplitude=400.0"),
+            format!("{wave}.amplitude"),
+        ),
+        (
+            format!("{wave}.amplitude=-1.0"),
+            format!("{wave}.amplitude"),
+        ),
+        // 1 mm period: 0.3 mm does not divide it.
+        (
+            format!("{wave}.wavelength=3.0e-4"),
+            format!("{wave}.wavelength"),
+        ),
+        (format!("{wave}.axis=\"z\""), format!("{wave}.axis")),
+        (format!("{wave}.axis=\"up\""), format!("{wave}.axis")),
+        ("check.surface=1.0".to_string(), "check.surface".to_string()),
+        (
+            "surface_tension.temperature_coefficient=0.0".to_string(),
+            "check.kind".to_string(),
+        ),
+    ] {
+        common::assert_input_error(&["validate", &scene, "--set", &set], &key);
+    }
+}
+
+/// Per-phase contact angles (F22: per liquid–solid pair): a table naming every
+/// wall and solid phase; one phase's table gives the same run as the number
+/// (the weighted direction of one angle is that angle to rounding: the sessile
+/// drop's figure agrees to the printed digits). Bad tables name the key.
+#[test]
+fn contact_angle_per_phase() {
+    let scene = common::scene("sessile_drop_2d");
+    let line = |angle: &str| {
+        let set = format!("surface_tension.contact_angle={angle}");
+        let (_, out) = run_check(
+            "sessile_drop_2d",
+            &[&set, "end_time=0.3"],
+            "check contact_angle:",
+        );
+        out.lines()
+            .find(|l| l.trim_start().starts_with("contact angle "))
+            .unwrap_or_else(|| panic!("{out}"))
+            .to_string()
+    };
+    assert_eq!(line("60.0"), line("{ substrate = 60.0 }"));
+    for (set, key) in [
+        (
+            "{ substrate = 190.0 }",
+            "surface_tension.contact_angle.substrate",
+        ),
+        ("{ }", "missing the angle on `substrate`"),
+    ] {
+        common::assert_input_error(
+            &[
+                "validate",
+                &scene,
+                "--set",
+                &format!("surface_tension.contact_angle={set}"),
+            ],
+            key,
+        );
+    }
 }

@@ -63,8 +63,8 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     liquid: u32,
     gas: u32,                // NO_PHASE in the free-surface form
     kappa_max: f32,          // free-surface form: |kappa| <= 1/support
-    cos_contact: f32,        // F22 (27): cos, sin of the contact angle (FLAG_WETTING)
-    sin_contact: f32,
+    pad0: f32,
+    pad1: f32,
     pad2: u32,
 }
 
@@ -134,8 +134,9 @@ struct Phase {
     vapor_constant: f32,     // C_M
     recondensation: f32,     // 0.82 c_s
     emissivity_sb: f32,      // emissivity * sigma_B
-    fixed_temperature: f32,  // a Dirichlet wall's temperature
-    pad0: f32,
+    contact_cos: f32,        // F22 (27): cos, sin of the liquid's contact angle on
+    contact_sin: f32,        // this wall/solid phase (FLAG_WETTING); a Dirichlet
+                             // wall's temperature is per particle (heat.x)
     pad1: f32,
     pad2: f32,
 }

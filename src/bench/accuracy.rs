@@ -121,6 +121,17 @@ pub const SWEEPS: &[Sweep] = &[
         quick: false,
     },
     Sweep {
+        name: "thermocapillary_2d",
+        text: scene_text!("thermocapillary_2d"),
+        // The liquid layer's thickness a: 10, 20, 40 Δx (the 1 mm period 40,
+        // 80, 160 Δx).
+        length: 2.5e-4,
+        cells: &[10, 20, 40],
+        expected_order: Some(1.0),
+        why: "the Marangoni stress acts as a body force over the liquid side's surface delta, about a dx thick: 1st order",
+        quick: false,
+    },
+    Sweep {
         name: "conduction_1d",
         text: scene_text!("conduction_1d"),
         length: 0.01,

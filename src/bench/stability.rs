@@ -64,6 +64,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/sessile_drop_2d"), &[]),
     (scene_file!("validation/square_drop_2d"), &["dx=4e-3"]),
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),
+    (scene_file!("validation/thermocapillary_2d"), &[]),
     (scene_file!("validation/two_layer_2d"), &["dx=0.01"]),
     (
         scene_file!("validation/two_layer_ratio1000_2d"),
@@ -350,11 +351,11 @@ fn momentum(st: &State) -> ([f64; 3], f64) {
     (p, scale)
 }
 
-fn enthalpy(st: &State) -> f64 {
-    st.heat
-        .iter()
-        .zip(&st.mass)
-        .map(|(h, &m)| h[0] as f64 * m as f64)
+/// Σ m h over conducting particles (a Dirichlet wall's heat.x is its temperature).
+fn enthalpy(m: &Model, st: &State) -> f64 {
+    (0..st.len())
+        .filter(|&i| m.phases[st.phase[i] as usize].conducts())
+        .map(|i| st.heat[i][0] as f64 * st.mass[i] as f64)
         .sum()
 }
 
@@ -503,8 +504,8 @@ fn run_and_judge(
         r.momentum_drift = Some(if scale > 0.0 { d / scale } else { d });
     }
     if keeps.enthalpy && !st0.heat.is_empty() {
-        let h0 = enthalpy(st0);
-        r.enthalpy_drift = Some((enthalpy(st1) - h0) / h0.abs().max(f64::MIN_POSITIVE));
+        let h0 = enthalpy(&l.model, st0);
+        r.enthalpy_drift = Some((enthalpy(&l.model, st1) - h0) / h0.abs().max(f64::MIN_POSITIVE));
     }
     read_back(dir, &report)?;
     let _ = std::fs::remove_dir_all(dir);

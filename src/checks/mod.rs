@@ -4,13 +4,16 @@
 //! One file per kind, each a `Check`: flow.rs (hydrostatic pressure, Poiseuille
 //! and Couette profiles), dam_break.rs (surge front against the experiments),
 //! two_layer.rs (liquid under gas), compression.rs (liquid density), heat.rs
-//! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy).
+//! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy),
+//! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
+//! thermocapillary.rs (Marangoni flow in a two-layer channel).
 
 mod compression;
 mod dam_break;
 mod flow;
 mod heat;
 mod tension;
+pub mod thermocapillary;
 mod two_layer;
 
 pub use dam_break::{fit_release_delay, ReleaseDelayFit};
@@ -127,6 +130,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::RecoilImpulse => Box::new(tension::RecoilImpulse::new(c)),
         CheckKind::DropShape => Box::new(tension::DropShape::default()),
         CheckKind::ContactAngle => Box::new(tension::ContactAngle::default()),
+        CheckKind::Thermocapillary => Box::new(thermocapillary::Thermocapillary::new(c)),
         CheckKind::Conduction1d => Box::new(heat::Conduction1d),
         CheckKind::ConductionTwoMaterials => Box::new(heat::TwoMaterials {
             interface: c.surface.unwrap_or(f64::NAN),

@@ -8,7 +8,7 @@ mod tension;
 mod thermal;
 
 pub use laser::{Laser, MAX_LASER_POINTS};
-pub use phases::{Evaporation, PhaseInfo, Thermal};
+pub use phases::{Evaporation, PhaseInfo, TemperatureWave, Thermal};
 pub use tension::SurfaceTension;
 
 use domain::{
@@ -421,6 +421,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 "\"contact_angle\" needs a 2D scene with surface_tension.contact_angle",
             ));
         }
+        if c.kind == crate::scene::CheckKind::Thermocapillary {
+            thermocapillary_layout(&cx, scene, dim, &phases, surface_tension.as_ref(), c)?;
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
@@ -547,4 +550,51 @@ fn barrier_def(
         stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
         damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
     }))
+}
+
+/// `check.kind = "thermocapillary"`: the channel the check's analytic solution
+/// describes. 2D, periodic in x, walls on y; F22's surface tension with α0' < 0;
+/// one Dirichlet wall phase with a temperature wave along x (the bottom) and one
+/// without (the top); `check.surface` (the interface height) inside the domain.
+fn thermocapillary_layout(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+    phases: &[PhaseInfo],
+    tension: Option<&SurfaceTension>,
+    c: &CheckDef,
+) -> Result<(), InputError> {
+    let bad = |msg: &str| Err(cx.err("check.kind", format!("\"thermocapillary\" needs {msg}")));
+    let d = &scene.domain;
+    if dim != 2
+        || !d.periodic.first().copied().unwrap_or(false)
+        || d.periodic.get(1).copied().unwrap_or(false)
+    {
+        return bad("a 2D scene periodic in x with walls on y");
+    }
+    if !tension.is_some_and(|t| t.gas.is_some() && t.slope < 0.0) {
+        return bad("[surface_tension] with a gas phase and a negative temperature_coefficient");
+    }
+    let walls: Vec<&Thermal> = phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Wall)
+        .filter_map(|p| p.thermal.as_ref())
+        .collect();
+    let waves = walls
+        .iter()
+        .filter(|t| t.wave.is_some_and(|w| w.axis == 0))
+        .count();
+    if waves != 1 || walls.len() != 2 {
+        return bad(
+            "two Dirichlet wall phases, one with a temperature_wave along x (the y_min wall)",
+        );
+    }
+    let y = c.surface.unwrap_or(f64::NAN);
+    if !(y > d.min[1] && y < d.max[1]) {
+        return Err(cx.err(
+            "check.surface",
+            format!("the interface height must lie inside the domain's y range, got {y}"),
+        ));
+    }
+    Ok(())
 }

@@ -39,6 +39,16 @@ pub struct Thermal {
     pub emissivity: f64,
     /// Mushy-zone sink C (1/s), 0 for none.
     pub mushy_damping: f64,
+    /// `temperature_wave`: T(x) = temperature + amplitude cos(2π x_axis / wavelength).
+    pub wave: Option<TemperatureWave>,
+}
+
+/// A cosine temperature along one axis (`phases.<name>.temperature_wave`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TemperatureWave {
+    pub amplitude: f64,
+    pub wavelength: f64,
+    pub axis: usize,
 }
 
 /// F22 (10), (18) constants: the scenario's table, once validated.
@@ -58,6 +68,20 @@ impl Evaporation {
 }
 
 impl Thermal {
+    /// The initial (or, on a Dirichlet wall, fixed) temperature at position x.
+    pub fn temperature_at(&self, x: [f64; 3]) -> f64 {
+        match self.wave {
+            None => self.temperature,
+            Some(w) => {
+                self.temperature
+                    + w.amplitude * (std::f64::consts::TAU * x[w.axis] / w.wavelength).cos()
+            }
+        }
+    }
+    /// The lowest temperature the phase starts with.
+    pub fn coldest(&self) -> f64 {
+        self.temperature - self.wave.map_or(0.0, |w| w.amplitude)
+    }
     /// The temperature whose enthalpy is stored as zero: the solidus for a melting
     /// material (so phases that switch into each other share it), else the phase's
     /// initial temperature. Particles store h − h(T_ref): f32 then resolves the

@@ -19,8 +19,9 @@ pub struct SurfaceTension {
     /// (T_m, ΔT_s): the liquid's solidus and the ramp width above it, in heat
     /// scenes whose liquid melts; None: no regularisation (f = 1).
     pub ramp: Option<(f64, f64)>,
-    /// F22 (27)–(29) static contact angle on walls and solids, radians.
-    pub contact_angle: Option<f64>,
+    /// F22 (27)–(29) static contact angle (radians) per phase: Some for every
+    /// wall and solid phase when the scene has wetting, None for the others.
+    pub contact_angle: Option<Vec<Option<f64>>>,
 }
 
 impl SurfaceTension {
@@ -35,7 +36,7 @@ impl SurfaceTension {
             Some((t_m, _)) => t_m,
             None => phases
                 .iter()
-                .filter_map(|p| p.thermal.map(|t| t.temperature))
+                .filter_map(|p| p.thermal.map(|t| t.coldest()))
                 .fold(self.reference_temperature, f64::min),
         };
         self.coefficient_at(t_low)
@@ -125,23 +126,9 @@ pub(super) fn surface_tension(
         }
         (None, None) => None,
     };
-    let contact_angle = match d.contact_angle {
+    let contact_angle = match &d.contact_angle {
         None => None,
-        Some(a) => {
-            if !(a.is_finite() && a > 0.0 && a < 180.0) {
-                return Err(cx.err(
-                    "surface_tension.contact_angle",
-                    format!("must lie strictly between 0 and 180 degrees, got {a}"),
-                ));
-            }
-            if gas.is_none() {
-                return Err(cx.err(
-                    "surface_tension.contact_angle",
-                    "wetting (F22 (27)-(29)) prescribes the liquid-gas normal: it needs F22's form with a gas phase",
-                ));
-            }
-            Some(a.to_radians())
-        }
+        Some(def) => Some(contact_angles(cx, def, phases, gas.is_some())?),
     };
     Ok(Some(SurfaceTension {
         contact_angle,
@@ -153,4 +140,63 @@ pub(super) fn surface_tension(
         minimum,
         ramp,
     }))
+}
+
+/// `surface_tension.contact_angle`, one angle or a table of every wall and solid
+/// phase, to radians per phase index (None for fluid phases).
+fn contact_angles(
+    cx: &Ctx,
+    def: &crate::scene::ContactAngleDef,
+    phases: &[PhaseInfo],
+    gas_form: bool,
+) -> Result<Vec<Option<f64>>, InputError> {
+    use crate::scene::ContactAngleDef;
+    let key = "surface_tension.contact_angle";
+    if !gas_form {
+        return Err(cx.err(
+            key,
+            "wetting (F22 (27)-(29)) prescribes the liquid-gas normal: it needs F22's form with a gas phase",
+        ));
+    }
+    let check = |k: &str, a: f64| -> Result<f64, InputError> {
+        if a.is_finite() && a > 0.0 && a < 180.0 {
+            Ok(a.to_radians())
+        } else {
+            Err(cx.err(
+                k,
+                format!("must lie strictly between 0 and 180 degrees, got {a}"),
+            ))
+        }
+    };
+    let solid = |p: &PhaseInfo| matches!(p.kind, PhaseKind::Wall | PhaseKind::Solid);
+    match def {
+        ContactAngleDef::All(a) => {
+            let a = check(key, *a)?;
+            Ok(phases.iter().map(|p| solid(p).then_some(a)).collect())
+        }
+        ContactAngleDef::PerPhase(table) => {
+            for name in table.keys() {
+                if !phases.iter().any(|p| &p.name == name && solid(p)) {
+                    return Err(cx.err(
+                        &format!("{key}.{name}"),
+                        format!("`{name}` is not a wall or solid phase of the scene"),
+                    ));
+                }
+            }
+            phases
+                .iter()
+                .map(|p| match (solid(p), table.get(&p.name)) {
+                    (false, _) => Ok(None),
+                    (true, Some(a)) => check(&format!("{key}.{}", p.name), *a).map(Some),
+                    (true, None) => Err(cx.err(
+                        key,
+                        format!(
+                            "missing the angle on `{}`: a table names every wall and solid phase",
+                            p.name
+                        ),
+                    )),
+                })
+                .collect()
+        }
+    }
 }

@@ -29,6 +29,7 @@ pub(super) fn thermal_table(
             continue;
         };
         cx.positive(&tkey, t)?;
+        let wave = temperature_wave(cx, scene, &ph.name, t)?;
         if ph.kind == PhaseKind::Wall {
             // A Dirichlet wall takes the conducting particle's own k (J22 (25)).
             ph.thermal = Some(Thermal {
@@ -40,6 +41,7 @@ pub(super) fn thermal_table(
                 evaporation: None,
                 emissivity: 0.0,
                 mushy_damping: 0.0,
+                wave,
             });
             continue;
         }
@@ -130,7 +132,64 @@ pub(super) fn thermal_table(
             evaporation,
             emissivity,
             mushy_damping,
+            wave,
         });
     }
     Ok(())
+}
+
+/// `phases.<name>.temperature_wave`: amplitude below the temperature (T > 0
+/// everywhere), an axis of the scene, and along a periodic axis a wavelength that
+/// divides the period (else the cosine jumps at the seam).
+fn temperature_wave(
+    cx: &Ctx,
+    scene: &SceneFile,
+    name: &str,
+    t: f64,
+) -> Result<Option<TemperatureWave>, InputError> {
+    let Some(w) = scene.phases[name].temperature_wave.as_ref() else {
+        return Ok(None);
+    };
+    let key = |k: &str| format!("phases.{name}.temperature_wave.{k}");
+    let amplitude = cx.positive(&key("amplitude"), w.amplitude)?;
+    if amplitude >= t {
+        return Err(cx.err(
+            &key("amplitude"),
+            format!("must be below the phase's temperature {t} K (T must stay positive), got {amplitude}"),
+        ));
+    }
+    let wavelength = cx.positive(&key("wavelength"), w.wavelength)?;
+    let dim = scene.simulation.dimension as usize;
+    let axis = match w.axis.as_str() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        other => {
+            return Err(cx.err(
+                &key("axis"),
+                format!("must be \"x\", \"y\" or \"z\", got \"{other}\""),
+            ))
+        }
+    };
+    if axis >= dim {
+        return Err(cx.err(
+            &key("axis"),
+            format!("`{}` is not an axis of a {dim}D scene", w.axis),
+        ));
+    }
+    let d = &scene.domain;
+    if d.periodic.get(axis).copied().unwrap_or(false) {
+        let periods = (d.max[axis] - d.min[axis]) / wavelength;
+        if (periods - periods.round()).abs() > 1e-9 * periods.max(1.0) || periods.round() < 1.0 {
+            return Err(cx.err(
+                &key("wavelength"),
+                format!("the domain is periodic along {} with length {} m: the wavelength must divide it (got {wavelength} m, {periods:.6} periods)", w.axis, d.max[axis] - d.min[axis]),
+            ));
+        }
+    }
+    Ok(Some(TemperatureWave {
+        amplitude,
+        wavelength,
+        axis,
+    }))
 }

@@ -117,11 +117,11 @@ pub fn velocity_channels(_m: &Model, st: &State) -> Vec<Field> {
 /// Specific enthalpy h(T) of particle i (J/kg): the stored value plus its phase's
 /// reference enthalpy (`Thermal::reference_enthalpy`).
 pub fn absolute_enthalpy(m: &Model, st: &State, i: usize) -> f64 {
-    let reference = m.phases[st.phase[i] as usize]
-        .thermal
-        .filter(|_| m.phases[st.phase[i] as usize].conducts())
-        .map_or(0.0, |t| t.reference_enthalpy());
-    st.heat[i][0] as f64 + reference
+    let ph = &m.phases[st.phase[i] as usize];
+    if !ph.conducts() {
+        return 0.0; // a Dirichlet wall's heat.x is its fixed temperature
+    }
+    st.heat[i][0] as f64 + ph.thermal.map_or(0.0, |t| t.reference_enthalpy())
 }
 
 /// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).

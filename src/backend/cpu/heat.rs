@@ -2,7 +2,8 @@
 //! F22 (41), Cleary & Monaghan 1999) and the temperature of each particle's
 //! enthalpy (J22 (19)).
 //!
-//! wall_temperature: a Dirichlet wall particle w takes T_w = 2 T_wall − T̃_w with
+//! wall_temperature: a Dirichlet wall particle w takes T_w = 2 T_wall − T̃_w (T_wall
+//!   its own fixed temperature, held in heat.x: a wall has no enthalpy) with
 //!   T̃_w = Σ_f T_f W_wf / Σ_f W_wf over conducting neighbours, the temperature
 //!   analogue of Adami (2012)'s no-slip velocity: the profile continues through the
 //!   wall and crosses T_wall at the wall face. (Holding the layers at T_wall instead
@@ -56,7 +57,7 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
                 sw += wk;
                 st_ += heat_in[j][1] * wk;
             });
-            let t_wall = pr.phases[ph as usize].fixed_temperature;
+            let t_wall = heat_in[i][0];
             Some(if sw > 0.0 {
                 2.0 * t_wall - st_ / sw
             } else {

@@ -122,8 +122,12 @@ fn solid_weight(pr: &Params, st: &State, j: usize) -> f32 {
 /// prints n̂ there, which is circular), n̂ = t sin θ − n^sf cos θ with θ = θ0 for
 /// the liquid and π − θ0 for the gas (its normal points the other way), and
 /// n = normalise(f n̂ + (1 − f) ñ), f = f[c^sf, 0, 0.2] (F22's c1, c2); δ kept.
+/// θ0 per wall or solid phase (F22: per liquid–solid pair): near several, the
+/// direction (cos θ0, sin θ0) averaged with the solid colour's weights V χ W and
+/// normalised (one phase: its own angle, to rounding).
 fn wet(pr: &Params, st: &State, grid: &CellTable, i: usize, n: [f32; 4]) -> [f32; 4] {
     let (mut c, mut g) = (0.0f32, [0.0f32; 3]);
+    let (mut cw, mut sw) = (0.0f32, 0.0f32);
     for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
         let ph = st.phase[j];
         if r2 <= 0.0 || !pr.is_wall(ph) {
@@ -131,7 +135,10 @@ fn wet(pr: &Params, st: &State, grid: &CellTable, i: usize, n: [f32; 4]) -> [f32
         }
         let r = r2.sqrt();
         let v = st.mass[j] / pr.phase(ph).rho0 * solid_weight(pr, st, j);
-        c += v * kernel::w(pr, r);
+        let wv = v * kernel::w(pr, r);
+        c += wv;
+        cw += wv * pr.phase(ph).contact_cos;
+        sw += wv * pr.phase(ph).contact_sin;
         let f = v * kernel::dw(pr, r) / r;
         for a in 0..3 {
             g[a] += f * d[a];
@@ -150,11 +157,14 @@ fn wet(pr: &Params, st: &State, grid: &CellTable, i: usize, n: [f32; 4]) -> [f32
     } else {
         [0.0; 3]
     };
-    let tension = &pr.tension;
-    let (cos, sin) = if st.phase[i] == tension.liquid {
-        (tension.cos_contact, tension.sin_contact)
+    let al = (cw * cw + sw * sw).sqrt();
+    if al <= 0.0 {
+        return n; // only neighbours with χ = 0 (molten solid)
+    }
+    let (cos, sin) = if st.phase[i] == pr.tension.liquid {
+        (cw / al, sw / al)
     } else {
-        (-tension.cos_contact, tension.sin_contact)
+        (-(cw / al), sw / al)
     };
     #[allow(clippy::manual_clamp)]
     let f = (c * 5.0).max(0.0).min(1.0);

@@ -56,7 +56,8 @@ pub struct State {
     pub phase: Vec<u32>,
     pub id: Vec<u32>,
     /// Heat scenes only (empty otherwise): specific enthalpy h (J/kg), temperature
-    /// T (K), liquid fraction f_l, dh/dt of the last step (W/kg).
+    /// T (K), liquid fraction f_l, dh/dt of the last step (W/kg). A Dirichlet
+    /// wall particle has no enthalpy: its .x is its fixed temperature.
     pub heat: Vec<[f32; 4]>,
     /// Scenes that need interfaces only (empty otherwise), 2n entries: first the
     /// outward unit normal and surface delta (n.xyz, δ) per particle, then the

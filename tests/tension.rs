@@ -360,12 +360,13 @@ fn sessile_drop_at_120_degrees_within_5() {
 /// Thermocapillary channel (Pendse & Esmaeeli 2010, scenarios/validation/
 /// thermocapillary_2d.toml): the interface velocity profile (20 points per
 /// wavelength) within 5% of the analytic amplitude, the issue's tolerance, at
-/// a = 20Δx, and the error falling from a = 10Δx. Measured 8.97% at 10Δx, 4.49%
-/// at 20Δx (61 s on 2 cores): first order, the Marangoni stress acting over the
-/// liquid side's surface delta (liquid rows +27.6% / +14.4% fast, the second
-/// fluid's first row −15.5% / −6.2% slow). The issue asks the tolerance at the
-/// finest of three resolutions; `spatter bench accuracy --scene
-/// thermocapillary_2d` runs a = 10, 20, 40Δx.
+/// a = 20Δx, and the error falling from a = 10Δx. Measured 8.97% / 4.49% /
+/// 2.78% at a = 10 / 20 / 40Δx (8 s, 61 s, 33 min on 2 cores): first order, the
+/// Marangoni stress acting over the liquid side's surface delta (liquid rows
+/// +27.6% / +14.4% / +7.2% fast, the second fluid's first row −15.5% / −6.2% /
+/// −2.4% slow). The issue asks the tolerance at the finest of three resolutions
+/// (met at 40Δx, too long for CI); `spatter bench accuracy --scenes
+/// thermocapillary_2d` runs all three.
 #[test]
 fn thermocapillary_interface_velocity_within_5_percent_and_converging() {
     let prefix = "check thermocapillary:";

@@ -16,6 +16,7 @@ pub mod outflow;
 pub mod output;
 pub mod params;
 pub mod portable_math;
+pub mod powder;
 pub mod run;
 pub mod scene;
 pub mod setup;

@@ -316,6 +316,9 @@ fn cmd_run(
     }
     println!("backend: {backend_name}");
     println!("particles: {}", loaded.state.len());
+    if let Some(b) = &loaded.model.powder {
+        println!("{}", b.summary(loaded.model.dim as usize));
+    }
     let opts = RunOptions {
         end,
         quiet: false,
@@ -504,6 +507,9 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             String::new()
         };
         println!("  {} ({:?}{motion}): {n}", ph.name, ph.kind);
+    }
+    if let Some(b) = &m.powder {
+        println!("{}", b.summary(m.dim as usize));
     }
     println!(
         "cell grid: {} x {} x {} = {} cells",

@@ -100,6 +100,37 @@ pub struct SceneFile {
     pub watchdog: WatchdogDef,
     pub laser: Option<LaserDef>,
     pub surface_tension: Option<SurfaceTensionDef>,
+    pub powder: Option<PowderDef>,
+}
+
+/// `[powder]`: a bed of grains poured into a box and levelled at its top
+/// (src/powder.rs). The vertical is the last axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PowderDef {
+    /// The grains' phase: solid (conducts, may melt) or wall. Fixed in place
+    /// until rigid bodies exist.
+    pub phase: String,
+    /// Grains rest on the box's bottom face, stay inside its sides and are
+    /// levelled at its top face.
+    #[serde(rename = "box")]
+    pub box_: BoxDef,
+    pub diameter: DiameterDef,
+    /// Seed of the grain sizes and drop positions (same seed, same bed).
+    #[serde(default)]
+    pub seed: u64,
+    /// Stop pouring after this many grains (default: until the box is full).
+    pub max_grains: Option<usize>,
+}
+
+/// `powder.diameter`: ln d ~ N(ln median, log_sigma²), clipped to [min, max] (m).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiameterDef {
+    pub median: f64,
+    pub log_sigma: f64,
+    pub min: f64,
+    pub max: f64,
 }
 
 /// `simulation.solid_fluid_viscosity`: F22 (33)'s α_0^sf and ΔT_d.

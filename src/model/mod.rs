@@ -119,6 +119,8 @@ pub struct Model {
     pub barrier: Option<Barrier>,
     /// F22 (24)–(26) surface tension between a liquid and a gas phase.
     pub surface_tension: Option<SurfaceTension>,
+    /// The poured `[powder]` bed.
+    pub powder: Option<crate::powder::PowderBed>,
     pub limits: DtLimits,
 }
 
@@ -436,6 +438,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
+    let powder = powder_bed(&cx, scene, dim, &phases)?;
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
@@ -499,8 +502,40 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         laser,
         barrier,
         surface_tension,
+        powder,
         limits,
     })
+}
+
+/// `[powder]`: the grains' phase (solid or wall), a box inside the domain, then
+/// the bed poured.
+fn powder_bed(
+    cx: &Ctx,
+    scene: &SceneFile,
+    dim: u32,
+    phases: &[PhaseInfo],
+) -> Result<Option<crate::powder::PowderBed>, InputError> {
+    let Some(def) = &scene.powder else {
+        return Ok(None);
+    };
+    let phase = phases
+        .iter()
+        .position(|p| p.name == def.phase)
+        .ok_or_else(|| cx.err("powder.phase", format!("no phase named `{}`", def.phase)))?;
+    if !matches!(phases[phase].kind, PhaseKind::Solid | PhaseKind::Wall) {
+        return Err(cx.err(
+            "powder.phase",
+            format!("`{}` must be a solid or wall phase: grains are fixed in place until rigid bodies exist", def.phase),
+        ));
+    }
+    let spec = crate::powder::spec(cx.file, def, phase, dim as usize)?;
+    let d = &scene.domain;
+    for k in 0..dim as usize {
+        if spec.lo[k] < d.min[k] || spec.hi[k] > d.max[k] {
+            return Err(cx.err("powder.box", "must lie inside the domain"));
+        }
+    }
+    Ok(Some(crate::powder::pour(spec, dim as usize)))
 }
 
 /// F22 (34) barrier: radius r_b (m), stiffness k_b (kg/s²), damping d_b (kg/(m s)).

@@ -80,6 +80,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         scene_file!("pbf/powder_bed_line_melt_coarse_2d"),
         &["dx=1e-5"],
     ),
+    (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
 ];
 
 /// The long runs `--quick` keeps (one per kind of physics).

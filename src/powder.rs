@@ -89,9 +89,36 @@ pub struct PowderBed {
     pub packing_fraction: f64,
     /// Lookup grid over the box: cell → grains overlapping it.
     grid: Grid,
+    /// The grain of each particle by its id (`NO_GRAIN` for none), from the
+    /// initial state (`attach`).
+    pub members: Vec<u32>,
 }
 
+/// `PowderBed::members` of a particle outside every grain.
+pub const NO_GRAIN: u32 = u32::MAX;
+
 impl PowderBed {
+    /// Records each particle's grain (by id) from the initial state, whose
+    /// positions are the lattice sites setup filled.
+    pub fn attach(&mut self, origin: [f64; 3], dim: usize, initial: &crate::state::State) {
+        let mut members = vec![NO_GRAIN; initial.len()];
+        for i in 0..initial.len() {
+            if initial.phase[i] as usize != self.spec.phase {
+                continue;
+            }
+            let p = initial.pos[i];
+            let x = [
+                p[0] as f64 + origin[0],
+                p[1] as f64 + origin[1],
+                p[2] as f64 + origin[2],
+            ];
+            if let Some(k) = self.grain_at(x, dim) {
+                members[initial.id[i] as usize] = k as u32;
+            }
+        }
+        self.members = members;
+    }
+
     /// The grain whose sphere holds x, if any.
     pub fn grain_at(&self, x: [f64; 3], dim: usize) -> Option<usize> {
         self.grid
@@ -241,6 +268,7 @@ pub fn pour(spec: PowderSpec, dim: usize) -> PowderBed {
         thickness,
         packing_fraction: solid / container,
         grid,
+        members: Vec::new(),
     }
 }
 

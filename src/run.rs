@@ -42,9 +42,18 @@ pub fn load(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
 /// are compiled into the binary.
 pub fn load_str(label: &str, text: &str, sets: &[String]) -> Result<Loaded, InputError> {
     let (scene, resolved) = scene::parse_str(label, text, sets)?;
-    let model = model::build(label, &scene, &resolved)?;
+    let mut model = model::build(label, &scene, &resolved)?;
     let state = setup::generate(&model, &scene)?;
+    attach_grains(&mut model, &state);
     Ok(Loaded { model, state })
+}
+
+/// A powder scene's grain of each particle id, from the initial state.
+fn attach_grains(model: &mut Model, initial: &State) {
+    let (origin, dim) = (model.origin, model.dim as usize);
+    if let Some(b) = model.powder.as_mut() {
+        b.attach(origin, dim, initial);
+    }
 }
 
 /// A run continued from a checkpoint: its stored scenario (with any `--set`
@@ -54,6 +63,12 @@ pub fn load_checkpoint(path: &str, sets: &[String]) -> Result<Loaded, InputError
     let label = format!("{path} (stored scenario {})", ck.header.scenario_file);
     let (scene, resolved) = scene::parse_str(&label, &ck.header.scenario, sets)?;
     let mut model = model::build(&label, &scene, &resolved)?;
+    if model.powder.is_some() {
+        // Grain membership comes from the initial lattice fill, which the
+        // checkpoint no longer shows (melt moves): regenerate it.
+        let initial = setup::generate(&model, &scene)?;
+        attach_grains(&mut model, &initial);
+    }
     model.file = ck.header.scenario_file.clone();
     if ck
         .state

@@ -42,6 +42,19 @@ pub struct Track {
     /// The depression under the beam at the last state observed.
     depression_now: Option<f64>,
     pub pool: PoolPeaks,
+    /// Powder scenes: which particles (by id) have been seen molten.
+    molten_ids: Vec<bool>,
+}
+
+/// Powder scenes: the grains by how much of them melted over the samples (a
+/// particle counts once seen with liquid fraction ≥ ½; it may have resolidified
+/// since).
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct GrainMelting {
+    pub grains: usize,
+    pub fully_molten: usize,
+    pub partially_molten: usize,
+    pub untouched: usize,
 }
 
 /// The melt pool's extremes over the samples of the run: the hottest particle
@@ -79,6 +92,8 @@ pub struct TrackProfile {
     pub dx: f64,
     pub slices: Vec<Slice>,
     pub pool: PoolPeaks,
+    /// Powder scenes only.
+    pub grains: Option<GrainMelting>,
 }
 
 fn condensed(m: &Model, st: &State, i: usize) -> bool {
@@ -114,6 +129,10 @@ impl Track {
             peak_t: vec![f64::NEG_INFINITY; slices],
             depression_now: None,
             pool: PoolPeaks::default(),
+            molten_ids: m
+                .powder
+                .as_ref()
+                .map_or(Vec::new(), |b| vec![false; b.members.len()]),
         };
         for i in 0..st.active() {
             if condensed(m, st, i) {
@@ -135,6 +154,13 @@ impl Track {
 
     /// Take in one state read back during the run.
     pub fn observe(&mut self, m: &Model, st: &State) {
+        for i in 0..st.active() {
+            if st.heat[i][2] >= 0.5 {
+                if let Some(seen) = self.molten_ids.get_mut(st.id[i] as usize) {
+                    *seen = true;
+                }
+            }
+        }
         let time = st.sim.time as f64;
         let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
         let mut deepest = f64::NEG_INFINITY;
@@ -260,7 +286,35 @@ impl Track {
             dx: self.dx,
             slices,
             pool: self.pool,
+            grains: self.grain_melting(m),
         }
+    }
+
+    fn grain_melting(&self, m: &Model) -> Option<GrainMelting> {
+        let bed = m.powder.as_ref()?;
+        let n = bed.grains.len();
+        let (mut size, mut molten) = (vec![0usize; n], vec![0usize; n]);
+        for (id, &g) in bed.members.iter().enumerate() {
+            if g == crate::powder::NO_GRAIN {
+                continue;
+            }
+            size[g as usize] += 1;
+            if self.molten_ids.get(id).copied().unwrap_or(false) {
+                molten[g as usize] += 1;
+            }
+        }
+        let mut out = GrainMelting {
+            grains: n,
+            ..GrainMelting::default()
+        };
+        for (s, k) in size.iter().zip(&molten) {
+            match (*k, *s) {
+                (0, _) => out.untouched += 1,
+                (k, s) if k == s => out.fully_molten += 1,
+                _ => out.partially_molten += 1,
+            }
+        }
+        Some(out)
     }
 }
 
@@ -291,6 +345,12 @@ impl TrackProfile {
             p.max_depression_time,
             if dim == 3 { format!(", widest {:.3e} m", p.max_width) } else { String::new() }
         )];
+        if let Some(g) = &self.grains {
+            lines.push(format!(
+                "powder: of {} grains {} fully molten, {} partially, {} untouched (a particle counts once seen with liquid fraction >= 1/2 at a sample)",
+                g.grains, g.fully_molten, g.partially_molten, g.untouched
+            ));
+        }
         let s = &self.slices;
         if s.is_empty() {
             lines.push("track: nothing melted".into());

@@ -60,7 +60,8 @@ pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
 /// channels in registry order: x, y, z (m), vx, vy, vz (m/s), density (kg/m³),
 /// pressure (Pa), mass (kg), phase (index into the scene's phases), id (the
 /// particle's index at setup, stable across reordering), and in heat scenes
-/// temperature (K), liquid fraction and specific enthalpy (J/kg).
+/// temperature (K), liquid fraction and specific enthalpy (J/kg); in powder
+/// scenes `grain` (index + 1 of the grain the particle was poured in, 0 none).
 ///
 /// Frames hold the particles still in the simulation only: the removed ones (the
 /// last `sim.removed` of the state, issue 18) are left out, so they do not hang
@@ -74,6 +75,21 @@ pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
         .filter_map(|f| f.frames)
         .flat_map(|channels| channels(m, st))
         .collect();
+    if let Some(b) = &m.powder {
+        // The grain each particle was poured in (index + 1; 0: none), by id.
+        let grain = st
+            .id
+            .iter()
+            .map(|&id| match b.members.get(id as usize) {
+                Some(&g) if g != crate::powder::NO_GRAIN => g + 1,
+                _ => 0,
+            })
+            .collect();
+        fields.push(Field {
+            name: "grain",
+            values: Values::U32(grain),
+        });
+    }
     for f in &mut fields {
         match &mut f.values {
             Values::F32(v) => v.truncate(active),

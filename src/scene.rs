@@ -119,7 +119,9 @@ pub struct PowderDef {
     /// Seed of the grain sizes and drop positions (same seed, same bed).
     #[serde(default)]
     pub seed: u64,
-    /// Stop pouring after this many grains (default: until the box is full).
+    /// Pour exactly this many grains and level nothing (the box's top is only
+    /// where the pour starts; the bed keeps the drawn diameters). Default: pour
+    /// until the box is full, levelled at its top.
     pub max_grains: Option<usize>,
 }
 

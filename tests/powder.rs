@@ -83,6 +83,8 @@ fn bad_powder_input_names_the_key() {
         ("powder.box.max=[9.6e-4, 3.0e-4]", "powder.box"),
         ("powder.box.max=[9.6e-4, 9.0e-5]", "powder.box.max"),
         ("powder.max_grains=0", "powder.max_grains"),
+        // 2000 unlevelled discs stand far above the 200 um domain.
+        ("powder.max_grains=2000", "powder.max_grains"),
         ("powder.colour=1", "colour"),
     ] {
         common::assert_input_error(&["validate", scene, "--set", set], key);

@@ -535,7 +535,20 @@ fn powder_bed(
             return Err(cx.err("powder.box", "must lie inside the domain"));
         }
     }
-    Ok(Some(crate::powder::pour(spec, dim as usize)))
+    let bed = crate::powder::pour(spec, dim as usize);
+    let up = dim as usize - 1;
+    if bed.spec.lo[up] + bed.thickness > d.max[up] {
+        return Err(cx.err(
+            "powder.max_grains",
+            format!(
+                "the bed of {} grains rises to {:.4e} m, above the domain's top {:.4e} m",
+                bed.grains.len(),
+                bed.spec.lo[up] + bed.thickness,
+                d.max[up]
+            ),
+        ));
+    }
+    Ok(Some(bed))
 }
 
 /// F22 (34) barrier: radius r_b (m), stiffness k_b (kg/s²), damping d_b (kg/(m s)).

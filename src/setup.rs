@@ -268,16 +268,17 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         for (iy, &(y, wy)) in axes[1].iter().enumerate() {
             for (ix, &(x, wx)) in axes[0].iter().enumerate() {
                 let p = [x, y, z];
-                let grain = m
-                    .powder
-                    .as_ref()
-                    .filter(|b| b.grain_at(p, m.dim as usize).is_some())
-                    .map(|b| b.spec.phase);
+                let grain = || {
+                    m.powder
+                        .as_ref()
+                        .filter(|b| b.grain_at(p, m.dim as usize).is_some())
+                        .map(|b| b.spec.phase)
+                };
                 let (phase, shape) = if wx || wy || wz {
                     (wall_phase_at(m, scene, p), None)
-                } else if grain.is_some() {
+                } else if let Some(grain) = grain() {
                     // The bed overrides the shapes (gas everywhere, then powder).
-                    (grain, None)
+                    (Some(grain), None)
                 } else {
                     scene
                         .shapes

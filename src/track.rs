@@ -154,7 +154,13 @@ impl Track {
 
     /// Take in one state read back during the run.
     pub fn observe(&mut self, m: &Model, st: &State) {
-        for i in 0..st.active() {
+        // Powder scenes only (the tally is empty otherwise).
+        let tally = if self.molten_ids.is_empty() {
+            0
+        } else {
+            st.active()
+        };
+        for i in 0..tally {
             if st.heat[i][2] >= 0.5 {
                 if let Some(seen) = self.molten_ids.get_mut(st.id[i] as usize) {
                     *seen = true;

@@ -75,6 +75,10 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
         dt = P.time_step.capillary_limit;
         which = 6u;
     }
+    if (P.time_step.contact_limit < dt) {
+        dt = P.time_step.contact_limit;
+        which = 7u;
+    }
     if (amax2 > 0.0) {
         let f = c_quarter() * sqrt(h / sqrt(amax2));
         if (f < dt) {

@@ -1,4 +1,4 @@
-// uses: params bindings kernel grid phase
+// uses: params bindings consts kernel grid phase rigid
 // writes: rho press vel
 // Generalized wall boundary (Adami, Hu & Adams 2012): each wall particle gathers
 // pressure and velocity from its fluid neighbours. Twin of src/backend/cpu/wall.rs.
@@ -45,7 +45,14 @@ fn wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
-    let b = P.phases[ph].velocity;
+    // The wall's own velocity: its phase's, or a body particle's rigid motion.
+    var b = P.phases[ph].velocity;
+    if ((P.sizes.flags & FLAG_BODIES) != 0u) {
+        let k = body[id[i]];
+        if (k != NO_BODY) {
+            b = vec4<f32>(body_point_velocity(bodies[k], pi), 0.0);
+        }
+    }
     // Regularised Shepard division (the CPU twin explains why): as Σ W -> 0 the
     // pressure goes to 0 and the velocity to the wall's own, continuously.
     let g = P.flow.gravity;

@@ -4,7 +4,8 @@
 //! Layout (little-endian): magic `SPATCKPT`, u32 format version, u32 reserved,
 //! u64 header length, JSON header, then the arrays in `State` order (pos, vel, acc,
 //! acc_b as 4×f32; rho, p, mass as f32; phase, id as u32; heat as 4×f32 in heat
-//! scenes), the 32-byte `Sim`
+//! scenes; the interface and body arrays where held), the body table and member
+//! list (scenes with rigid bodies), the 32-byte `Sim`
 //! block, and a CRC-32 of everything before it. Files are written to a temporary
 //! name and renamed, so a checkpoint on disk is always complete.
 
@@ -19,7 +20,8 @@ use std::path::{Path, PathBuf};
 const MAGIC: &[u8; 8] = b"SPATCKPT";
 // 2: a Dirichlet wall particle's fixed temperature is its heat.x (was 0; version 1
 // files would resume with 0 K walls).
-const FORMAT_VERSION: u32 = 2;
+// 3: rigid bodies (body, body_offset, the body table and member list).
+const FORMAT_VERSION: u32 = 3;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
 const KEEP: usize = 2;
@@ -45,6 +47,13 @@ pub struct Header {
     /// The interface array (2n × 4 f32) follows the heat array.
     #[serde(default)]
     pub surface: bool,
+    /// Rigid bodies: the body and body_offset arrays follow, and after the
+    /// particle arrays the body table (`bodies` × 128 bytes) and the member list
+    /// (`members` × u32).
+    #[serde(default)]
+    pub bodies: u64,
+    #[serde(default)]
+    pub members: u64,
 }
 
 pub struct Checkpoint {
@@ -70,6 +79,8 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         rng_draws_after_setup: 0,
         heat: !st.heat.is_empty(),
         surface: !st.surface.is_empty(),
+        bodies: st.bodies.len() as u64,
+        members: st.members.len() as u64,
     };
     let json = serde_json::to_vec(&header).expect("checkpoint header serializes");
     let mut out = Vec::with_capacity(64 + json.len() + st.len() * 100);
@@ -82,6 +93,8 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
     for f in FIELDS.iter().filter(|f| f.checkpointed) {
         push(&mut out, (f.words)(st));
     }
+    push(&mut out, &st.bodies);
+    push(&mut out, &st.members);
     out.extend_from_slice(bytemuck::bytes_of(&st.sim));
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -140,6 +153,7 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
     let held = Held {
         heat: header.heat,
         interface: header.surface,
+        bodies: header.bodies > 0,
     };
     let mut state = State::default();
     for f in FIELDS.iter().filter(|f| f.checkpointed) {
@@ -147,6 +161,10 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         let bytes = c.take(count * f.bytes_per_particle()).ok_or_else(short)?;
         (f.set)(&mut state, bytes);
     }
+    let body_bytes = header.bodies as usize * std::mem::size_of::<crate::state::Body>();
+    state.bodies = bytemuck::pod_collect_to_vec(c.take(body_bytes).ok_or_else(short)?);
+    state.members =
+        bytemuck::pod_collect_to_vec(c.take(header.members as usize * 4).ok_or_else(short)?);
     state.sim =
         bytemuck::pod_read_unaligned::<Sim>(c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?);
     if c.at != body.len() {

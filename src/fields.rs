@@ -23,6 +23,8 @@ pub enum Holder {
     Heat,
     /// Scenes with interface normals.
     Interface,
+    /// Scenes with rigid bodies.
+    Bodies,
 }
 
 /// The scene's holders, from the pipeline's features.
@@ -30,6 +32,7 @@ pub enum Holder {
 pub struct Held {
     pub heat: bool,
     pub interface: bool,
+    pub bodies: bool,
 }
 
 impl Held {
@@ -38,6 +41,7 @@ impl Held {
             Holder::Every => true,
             Holder::Heat => self.heat,
             Holder::Interface => self.interface,
+            Holder::Bodies => self.bodies,
         }
     }
     /// What a state holds (its optional arrays are empty when not held).
@@ -45,6 +49,7 @@ impl Held {
         Held {
             heat: !st.heat.is_empty(),
             interface: !st.surface.is_empty(),
+            bodies: !st.body.is_empty(),
         }
     }
 }
@@ -112,7 +117,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 11] = [
+pub const FIELDS: [FieldDef; 13] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -133,6 +138,11 @@ pub const FIELDS: [FieldDef; 11] = [
     field!("heat", heat, "heat", Some("s_heat"), 4, 1, true, Holder::Heat,
         Some(output::heat_channels)),
     field!("surface", surface, "surface", None, 4, 2, true, Holder::Interface, None),
+    // Indexed by particle id, not sorted (no scratch: they never change).
+    field!("body", body, "body", None, 1, 1, false, Holder::Bodies,
+        Some(output::body_channels)),
+    field!("body_offset", body_offset, "body_offset", None, 4, 1, true, Holder::Bodies,
+        None),
 ];
 
 /// out[k] = v[perm[k]], in parallel.
@@ -156,6 +166,7 @@ pub fn wgsl_reorder(k: &str, s: &str, indent: &str) -> String {
             h => {
                 let flag = match h {
                     Holder::Heat => "FLAG_HEAT",
+                    Holder::Bodies => "FLAG_BODIES",
                     _ => "FLAG_INTERFACE",
                 };
                 out.push_str(&format!(

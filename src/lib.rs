@@ -3,6 +3,7 @@
 
 pub mod backend;
 pub mod bench;
+pub mod bodies;
 pub mod checkpoint;
 pub mod checks;
 pub mod compare;

@@ -38,6 +38,9 @@ pub const FLAG_FREE_SURFACE_TENSION: u32 = 1024;
 /// Wetting by a prescribed normal near walls and solids, F22 (27)–(29)
 /// (`tension.cos_contact`, `tension.sin_contact`).
 pub const FLAG_WETTING: u32 = 2048;
+/// The scene has rigid bodies (`bodies`): the body passes run and the body
+/// fields exist.
+pub const FLAG_BODIES: u32 = 4096;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -128,7 +131,8 @@ gpu_struct! {
         pub barrier_limit: f32,
         /// 0.25 √(ρ h³/(2π α)), the capillary limit.
         pub capillary_limit: f32,
-        pub pad1: f32,
+        /// 0.22 √(m/k_c), the body contact limit (F22 (42)).
+        pub contact_limit: f32,
         pub pad2: f32,
     }
 }
@@ -308,6 +312,19 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Rigid bodies and their contact F22 (39)–(40) (FLAG_BODIES).
+    pub struct Bodies {
+        pub n_bodies: u32,
+        /// k_c.
+        pub contact_stiffness: f32,
+        /// d_c.
+        pub contact_damping: f32,
+        /// Contact acts below this distance: Δx (F22 (40)).
+        pub contact_distance: f32,
+    }
+}
+
+gpu_struct! {
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
@@ -359,6 +376,7 @@ gpu_struct! {
         pub surfaces: Surfaces,
         pub tension: Tension,
         pub laser: Laser,
+        pub bodies: Bodies,
         pub phases: [Phase; MAX_PHASES],
         pub consts: Consts,
     }
@@ -448,7 +466,7 @@ impl Params {
             fixed_dt: m.fixed_dt.unwrap_or(0.0) as f32,
             barrier_limit: finite_or_max(m.limits.barrier),
             capillary_limit: finite_or_max(m.limits.capillary),
-            pad1: 0.0,
+            contact_limit: finite_or_max(m.limits.contact),
             pad2: 0.0,
         };
         p.flow = Flow {
@@ -471,6 +489,15 @@ impl Params {
             p.phases[i] = phase_block(ph);
         }
         p.laser = laser_block(m);
+        if let Some(c) = m.contact.filter(|_| m.has_bodies()) {
+            p.sizes.flags |= FLAG_BODIES;
+            p.bodies = Bodies {
+                n_bodies: m.bodies.len() as u32,
+                contact_stiffness: c.stiffness as f32,
+                contact_damping: c.damping as f32,
+                contact_distance: m.dx as f32,
+            };
+        }
         p.consts = SHADER_CONSTS;
         if m.needs_interface() {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);

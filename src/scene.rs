@@ -101,6 +101,19 @@ pub struct SceneFile {
     pub laser: Option<LaserDef>,
     pub surface_tension: Option<SurfaceTensionDef>,
     pub powder: Option<PowderDef>,
+    pub contact: Option<ContactDef>,
+}
+
+/// `[contact]`: F22 (39)–(40), the repulsive spring–dashpot between particles of
+/// different rigid bodies and between a body and the walls or substrate, acting
+/// within one particle spacing. F22 has no friction, and neither has spatter.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDef {
+    /// k_c (kg/s²; F22: 1.0).
+    pub stiffness: f64,
+    /// d_c (kg/s; F22: 1e-4).
+    pub damping: f64,
 }
 
 /// `[powder]`: a bed of grains poured into a box and levelled at its top
@@ -453,9 +466,16 @@ pub struct ShapeDef {
     pub box_: Option<BoxDef>,
     pub sphere: Option<SphereDef>,
     pub cylinder: Option<CylinderDef>,
-    /// Initial velocity of the shape's particles (m/s; liquid and gas phases
-    /// only): a jet, a droplet in flight. Absent: at rest.
+    /// Initial velocity of the shape's particles (m/s; liquid and gas phases,
+    /// and rigid bodies): a jet, a droplet in flight. Absent: at rest.
     pub velocity: Option<Vec<f64>>,
+    /// The shape's particles (of a wall or solid phase) form one rigid body
+    /// (F22 §2.2): they keep their places in the body's frame and move with it.
+    #[serde(default)]
+    pub body: bool,
+    /// A body's initial angular velocity (rad/s): 3 components in 3D, 1 (about z)
+    /// in 2D.
+    pub angular_velocity: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -549,6 +569,8 @@ pub struct CheckDef {
     pub radius: Option<f64>,
     /// Recoil impulse: area of the hot surface (m², m per metre of depth in 2D).
     pub area: Option<f64>,
+    /// Free rotation: the largest relative change of the rotational energy.
+    pub energy_tolerance: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -600,6 +622,15 @@ pub enum CheckKind {
     /// Marangoni flow in a two-layer channel over a wall heated as a cosine
     /// (Pendse & Esmaeeli 2010): the interface velocity against the Stokes solution.
     Thermocapillary,
+    /// Two rigid bodies collide head-on: the coefficient of restitution against
+    /// the spring–dashpot's analytic value.
+    Restitution,
+    /// A free rigid body: angular momentum and energy conserved, the
+    /// intermediate-axis flip.
+    FreeRotation,
+    /// A body lighter than the liquid floats with the immersed depth Archimedes
+    /// gives.
+    Flotation,
 }
 
 impl CheckKind {
@@ -623,6 +654,9 @@ impl CheckKind {
             CheckKind::DropShape => "drop_shape",
             CheckKind::ContactAngle => "contact_angle",
             CheckKind::Thermocapillary => "thermocapillary",
+            CheckKind::Restitution => "restitution",
+            CheckKind::FreeRotation => "free_rotation",
+            CheckKind::Flotation => "flotation",
         }
     }
 }

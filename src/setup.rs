@@ -7,7 +7,7 @@
 use crate::error::InputError;
 use crate::model::Model;
 use crate::scene::{SceneFile, ShapeDef};
-use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT};
+use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT, NO_BODY};
 
 /// Lattice coordinates along one axis: positions and whether each is in a wall layer.
 fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
@@ -58,6 +58,7 @@ pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
     let held = crate::fields::Held {
         heat: m.is_thermal(),
         interface: m.needs_interface(),
+        bodies: m.has_bodies(),
     };
     let per_particle = crate::fields::bytes_per_particle(held) as u64 + BYTES_PER_PARTICLE_SORT;
     particles * per_particle as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
@@ -174,7 +175,7 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
                     format!("needs {dim} finite components (m/s)"),
                 ));
             }
-            if !m.phases[pi].is_fluid() {
+            if !m.phases[pi].is_fluid() && !s.body {
                 return Err(InputError::new(
                     &m.file,
                     &key("velocity"),
@@ -264,6 +265,12 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     let mut st = State::default();
     // Lattice index of every particle, for the hydrostatic start's columns.
     let mut sites: Vec<[u32; 3]> = Vec::new();
+    // Each shape's body (NO_BODY: not a body), and each particle's.
+    let mut body_index = vec![NO_BODY; scene.shapes.len()];
+    for (k, b) in m.bodies.iter().enumerate() {
+        body_index[b.shape] = k as u32;
+    }
+    let mut body_of: Vec<u32> = Vec::new();
     for (iz, &(z, wz)) in axes[2].iter().enumerate() {
         for (iy, &(y, wy)) in axes[1].iter().enumerate() {
             for (ix, &(x, wx)) in axes[0].iter().enumerate() {
@@ -283,9 +290,10 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                     scene
                         .shapes
                         .iter()
+                        .enumerate()
                         .zip(&shape_phase)
                         .rev()
-                        .find(|(s, _)| inside(s, p, m.dim as usize))
+                        .find(|((_, s), _)| inside(s, p, m.dim as usize))
                         .map_or((None, None), |(s, &pi)| (Some(pi), Some(s)))
                 };
                 let Some(pi) = phase else { continue };
@@ -296,7 +304,9 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                     }
                 }
                 push_particle(m, &mut st, q, pi);
-                if let Some(v) = shape.and_then(|s| s.velocity.as_ref()) {
+                body_of.push(shape.map_or(NO_BODY, |(k, _)| body_index[k]));
+                let fluid_shape = shape.map(|(_, s)| s).filter(|s| !s.body);
+                if let Some(v) = fluid_shape.and_then(|s| s.velocity.as_ref()) {
                     let last = st.vel.len() - 1;
                     for (a, c) in v.iter().enumerate() {
                         st.vel[last][a] = *c as f32;
@@ -306,10 +316,23 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
             }
         }
     }
+    if m.has_bodies() {
+        for (k, b) in m.bodies.iter().enumerate() {
+            if !body_of.contains(&(k as u32)) {
+                return Err(InputError::new(
+                    &m.file,
+                    &format!("shapes[{}]", b.shape),
+                    "this body covers no lattice site (too small, or covered by later shapes)",
+                ));
+            }
+        }
+        crate::bodies::assemble(m, &mut st, &body_of);
+    }
     if !st
         .phase
         .iter()
         .any(|&p| m.phases[p as usize].is_fluid() || m.phases[p as usize].conducts())
+        && !m.has_bodies()
     {
         return Err(InputError::new(&m.file, "shapes", "the scene contains no fluid or solid particle (no shape of a liquid, gas or solid phase covers a lattice site)"));
     }

@@ -21,7 +21,7 @@ pub struct Sim {
     pub _pad: u32,
 }
 
-pub const DT_LIMIT_NAMES: [&str; 7] = [
+pub const DT_LIMIT_NAMES: [&str; 8] = [
     "acoustic",
     "viscous",
     "force",
@@ -29,6 +29,7 @@ pub const DT_LIMIT_NAMES: [&str; 7] = [
     "conduction",
     "barrier",
     "capillary",
+    "contact",
 ];
 
 /// Name of the limit code the timestep pass wrote.
@@ -63,7 +64,51 @@ pub struct State {
     /// outward unit normal and surface delta (n.xyz, δ) per particle, then the
     /// Shepard sum Γ (in .x) the interface pass computes on the way.
     pub surface: Vec<[f32; 4]>,
+    /// Scenes with rigid bodies only (empty otherwise): the body a particle
+    /// belongs to (`NO_BODY` for the rest) and its offset from the body's centre of
+    /// mass in the body (principal) frame (xyz; w 0). Both indexed by particle
+    /// id (`body[id[i]]`), not sorted: they never change, and unsorted they need
+    /// no reorder scratch (lavapipe allows 32 storage buffers per pass).
+    pub body: Vec<u32>,
+    pub body_offset: Vec<[f32; 4]>,
+    /// One entry per rigid body (crate::bodies), in body order.
+    pub bodies: Vec<Body>,
+    /// Particle ids of every body's members, body after body in ascending id
+    /// (`Body::first`, `Body::count`): the fixed order of the per-body sums.
+    pub members: Vec<u32>,
     pub sim: Sim,
+}
+
+/// `State::body` of a particle that belongs to no body.
+pub const NO_BODY: u32 = u32::MAX;
+
+/// One rigid body (F22 §2.2, §3.4): its state and mass properties in f32, the
+/// same bits on both backends (WGSL twin `Body` in shaders/lib/params.wgsl).
+/// Vectors are world-frame unless said; positions are grid-relative.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable, Default)]
+pub struct Body {
+    /// Centre of mass (xyz), mass (w).
+    pub x: [f32; 4],
+    /// Orientation: the unit quaternion (x, y, z, w) taking body-frame vectors to
+    /// world vectors.
+    pub q: [f32; 4],
+    /// Velocity of the centre of mass (w 0).
+    pub v: [f32; 4],
+    /// Angular momentum about the centre of mass (w 0).
+    pub l: [f32; 4],
+    /// Principal moments of inertia (w 0).
+    pub inertia: [f32; 4],
+    /// Σ f over the members at the last force evaluation (contact and fluid;
+    /// gravity is added in the kicks), world frame.
+    pub force: [f32; 4],
+    /// Σ (x_r − x_k) × f_r, world frame.
+    pub torque: [f32; 4],
+    /// The body's members: `State::members[first..first + count]`.
+    pub first: u32,
+    pub count: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }
 
 /// A field viewed as raw 32-bit words, for bit-exact comparison.
@@ -86,10 +131,11 @@ impl State {
     pub fn active(&self) -> usize {
         self.len() - (self.sim.removed as usize).min(self.len())
     }
-    /// The compared fields this state holds, in registry order (crate::fields).
+    /// The compared fields this state holds, in registry order (crate::fields),
+    /// then the body table (32 words per body) in scenes with rigid bodies.
     pub fn fields(&self) -> Vec<FieldView<'_>> {
         let held = crate::fields::Held::of_state(self);
-        crate::fields::FIELDS
+        let mut out: Vec<FieldView<'_>> = crate::fields::FIELDS
             .iter()
             .filter(|f| f.compared && held.holds(f.holder))
             .map(|f| FieldView {
@@ -98,7 +144,16 @@ impl State {
                 words: (f.words)(self),
                 is_float: f.is_float,
             })
-            .collect()
+            .collect();
+        if !self.bodies.is_empty() {
+            out.push(FieldView {
+                name: "bodies",
+                components: 32,
+                words: bytemuck::cast_slice(&self.bodies),
+                is_float: true,
+            });
+        }
+        out
     }
 }
 

@@ -130,10 +130,14 @@ fn wgsl_params_match_rust_member_for_member() {
         std::mem::size_of::<rs::Params>(),
         "block size"
     );
-    // The Sim block is read back by bytes: same size.
+    // The Sim block and the body table are read back by bytes: same size.
     assert_eq!(
         naga_struct_size(PARAMS_WGSL, "Sim") as usize,
         std::mem::size_of::<spatter::state::Sim>()
+    );
+    assert_eq!(
+        naga_struct_size(PARAMS_WGSL, "Body") as usize,
+        std::mem::size_of::<spatter::state::Body>()
     );
 }
 
@@ -198,6 +202,8 @@ fn flag_and_code_constants_match() {
         ("FLAG_RECOIL", rs::FLAG_RECOIL),
         ("FLAG_FREE_SURFACE_TENSION", rs::FLAG_FREE_SURFACE_TENSION),
         ("FLAG_WETTING", rs::FLAG_WETTING),
+        ("FLAG_BODIES", rs::FLAG_BODIES),
+        ("NO_BODY", spatter::state::NO_BODY),
         ("NO_PHASE", rs::NO_PHASE),
         ("KIND_LIQUID", rs::KIND_LIQUID),
         ("KIND_GAS", rs::KIND_GAS),

@@ -17,7 +17,9 @@ As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
 (time, {field: numpy array}) of the particles still in the simulation;
 info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
 speed, mass); info["track"] is the /track message of a laser scene (None
-without); read_vtu(path) -> {field: numpy array}.
+without); info["bodies"] the /bodies messages of a scene with rigid bodies (one
+per frame: time, and per body its position, orientation, velocity, angular
+velocity, mass); read_vtu(path) -> {field: numpy array}.
 A file whose writer was killed (no summary) is read up to its last complete chunk.
 """
 import json
@@ -87,7 +89,7 @@ def _messages(path):
 
 def read_mcap(path):
     frames, diagnostics, removed = [], [], []
-    info = {"schemas": {}, "metadata": {}, "track": None}
+    info = {"schemas": {}, "metadata": {}, "track": None, "bodies": []}
     for schema, channel, message, decoded in _messages(path):
         info["schemas"][channel.topic] = schema.name if schema else ""
         if channel.topic == "/particles":
@@ -98,6 +100,8 @@ def read_mcap(path):
             removed.append(decoded)
         elif channel.topic == "/track":
             info["track"] = decoded
+        elif channel.topic == "/bodies":
+            info["bodies"].append(decoded)
     info["removed"] = sorted(removed, key=lambda r: (r["time"], r["id"]))
     info["complete"] = is_complete(path)
     info["metadata"] = read_metadata(path)
@@ -161,6 +165,7 @@ def summary(path):
                             for side in sorted({r["side"] for r in info["removed"]})},
         "schemas": info["schemas"],
         "track_slices": len(info["track"]["slices"]) if info["track"] else None,
+        "bodies": len(info["bodies"][-1]["bodies"]) if info["bodies"] else 0,
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),
     }

@@ -35,3 +35,13 @@
 // 1 where a cell holds a fluid particle (set in cell_bounds; the wall pass skips
 // wall particles with no such cell around them). Order-free integer atomics.
 @group(0) @binding(26) var<storage, read_write> cell_fluid: array<atomic<u32>>;
+// Rigid-body scenes: each particle's body (NO_BODY: none) and its body-frame
+// offset, both indexed by particle id (body[id[i]]: they never change, so they
+// are not sorted and need no scratch); the body table, the members of every body
+// by particle id (body after body) and each id's current index (body_slots).
+// Placeholders otherwise.
+@group(0) @binding(27) var<storage, read_write> body: array<u32>;
+@group(0) @binding(28) var<storage, read_write> body_offset: array<vec4<f32>>;
+@group(0) @binding(29) var<storage, read_write> bodies: array<Body>;
+@group(0) @binding(30) var<storage, read_write> members: array<u32>;
+@group(0) @binding(31) var<storage, read_write> slots: array<u32>;

@@ -37,7 +37,7 @@ struct TimeStep {
     fixed_dt: f32,           // 0: adaptive
     barrier_limit: f32,      // 0.22 sqrt(m/k_b)
     capillary_limit: f32,    // 0.25 sqrt(rho h^3/(2 pi alpha))
-    pad1: f32,
+    contact_limit: f32,      // 0.22 sqrt(m/k_c)
     pad2: f32,
 }
 
@@ -106,6 +106,13 @@ struct Laser {
     pad1: u32,
     path: array<PathPoint, 8>,
     power: array<PowerStep, 8>,
+}
+
+struct Bodies {              // rigid bodies, F22 (39)-(40) contact (FLAG_BODIES)
+    n_bodies: u32,
+    contact_stiffness: f32,  // k_c
+    contact_damping: f32,    // d_c
+    contact_distance: f32,   // dx
 }
 
 struct Phase {
@@ -186,6 +193,7 @@ struct Params {
     surfaces: Surfaces,
     tension: Tension,
     laser: Laser,
+    bodies: Bodies,
     phases: array<Phase, 8>,
     consts: Consts,
 }
@@ -201,6 +209,21 @@ struct Sim {
     pad0: u32,
 }
 
+// One rigid body: twin of src/state.rs `Body` (world frame, grid-relative).
+struct Body {
+    x: vec4<f32>,            // centre of mass, w: mass
+    q: vec4<f32>,            // orientation quaternion (x, y, z, w), body -> world
+    v: vec4<f32>,            // velocity of the centre of mass
+    l: vec4<f32>,            // angular momentum about the centre of mass
+    inertia: vec4<f32>,      // principal moments
+    force: vec4<f32>,        // sum of member forces (contact, fluid)
+    torque: vec4<f32>,       // sum of (x_r - x_k) x f_r
+    first: u32,              // members[first .. first + count]
+    count: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
 const FLAG_VISCOUS_HEATING: u32 = 16u;
 const FLAG_HEAT: u32 = 32u;
@@ -210,6 +233,8 @@ const FLAG_SURFACE_TENSION: u32 = 256u;
 const FLAG_RECOIL: u32 = 512u;
 const FLAG_FREE_SURFACE_TENSION: u32 = 1024u;
 const FLAG_WETTING: u32 = 2048u;
+const FLAG_BODIES: u32 = 4096u;
+const NO_BODY: u32 = 4294967295u;
 const NO_PHASE: u32 = 4294967295u;
 const KIND_LIQUID: u32 = 0u;
 const KIND_GAS: u32 = 1u;

@@ -5,8 +5,8 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL,
-    FLAG_SURFACE_TENSION, FLAG_WETTING, LASER_BEER_LAMBERT, LASER_SURFACE,
+    Params, FLAG_BODIES, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
+    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -39,35 +39,45 @@ pub enum Stage {
     Kick,
     /// max |u|, |a| reductions and the F22 (42) time step.
     Timestep,
+    /// Rigid bodies: first half kick, drift and free rotation; members placed.
+    BodyDrift,
+    /// Rigid bodies: F22 (39)–(40) contact on members, per-body force and torque.
+    BodyForces,
+    /// Rigid bodies: second half kick.
+    BodyKick,
 }
 
 /// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
 /// previous step, then the temperatures following the new enthalpies.
-pub const STEP: [Stage; 12] = [
+pub const STEP: [Stage; 15] = [
     Stage::KickDrift,     // v += Δt/2 a, x += Δt ṽ (transport velocity)
+    Stage::BodyDrift,     // bodies: V, L += Δt/2 (F, τ); X += Δt V; rotate; place
     Stage::Neighbors,     // sort by cell, cell table
     Stage::Density,       // ρ = m Σ W, p = c² (ρ − ρ0)
     Stage::Wall,          // wall pressure and velocity extrapolated from the fluid
     Stage::Interface,     // interface normals and surface delta
     Stage::Forces,        // pressure, viscous forces, barrier; gravity
     Stage::SurfaceForces, // surface tension, Marangoni stress, recoil
+    Stage::BodyForces,    // contact on body particles; per-body F, τ
     Stage::Laser,         // absorbed laser power
     Stage::Heat,          // conduction and surface losses, enthalpy update
     Stage::Temperature,   // T and f_l from h; melting and solidification
     Stage::Kick,          // v += Δt/2 a
+    Stage::BodyKick,      // bodies: V, L += Δt/2 (F, τ)
     Stage::Timestep,      // Δt for the next step
 ];
 
 /// Run once before the first step: accelerations, temperatures and Δt of the
 /// initial state.
-pub const PRIME: [Stage; 8] = [
+pub const PRIME: [Stage; 9] = [
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
     Stage::Interface,
     Stage::Forces,
     Stage::SurfaceForces,
+    Stage::BodyForces,
     Stage::Temperature,
     Stage::Timestep,
 ];
@@ -97,6 +107,8 @@ pub struct Features {
     pub wetting: bool,
     /// F22 (30) recoil pressure.
     pub recoil: bool,
+    /// Rigid bodies (F22 §2.2).
+    pub bodies: bool,
 }
 
 impl Features {
@@ -117,6 +129,7 @@ impl Features {
             free_surface_tension: params.flag(FLAG_FREE_SURFACE_TENSION),
             wetting: params.flag(FLAG_WETTING),
             recoil: params.flag(FLAG_RECOIL),
+            bodies: params.flag(FLAG_BODIES),
         }
     }
 }
@@ -138,6 +151,8 @@ pub enum Work {
     Reduction,
     /// A single workgroup.
     Single,
+    /// One thread per rigid body.
+    Bodies,
 }
 
 /// One GPU entry point of a stage, dispatched when `when` holds.
@@ -168,7 +183,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 12] = [
+pub const STAGES: [StageDef; 15] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -333,6 +348,37 @@ pub const STAGES: [StageDef; 12] = [
         ],
         cpu: |b| b.timestep(),
     },
+    StageDef {
+        stage: Stage::BodyDrift,
+        name: "bodies.drift",
+        file: "bodies",
+        needed: |f| f.bodies,
+        gpu: &[
+            always("body_drift", Work::Bodies),
+            always("body_place", Work::Particles),
+        ],
+        cpu: |b| b.body_drift(),
+    },
+    StageDef {
+        stage: Stage::BodyForces,
+        name: "bodies.forces",
+        file: "bodies",
+        needed: |f| f.bodies,
+        gpu: &[
+            always("body_forces", Work::Particles),
+            always("body_slots", Work::Particles),
+            always("body_sum", Work::Bodies),
+        ],
+        cpu: |b| b.body_forces(),
+    },
+    StageDef {
+        stage: Stage::BodyKick,
+        name: "bodies.kick",
+        file: "bodies",
+        needed: |f| f.bodies,
+        gpu: &[always("body_kick", Work::Bodies)],
+        cpu: |b| b.body_kick(),
+    },
 ];
 
 impl Stage {
@@ -372,6 +418,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 26);
+        assert_eq!(e.len(), 32);
     }
 }

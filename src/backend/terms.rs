@@ -82,11 +82,18 @@ pub fn active(params: &Params, name: &str) -> bool {
     (t.active)(params)
 }
 
+/// Terms another pass evaluates from the other side of the pair: the rigid-body
+/// pass sums the fluid's pressure and viscous force on each body particle (F22
+/// (38), the reaction f_ri = −m_i a_ir) with the forces pass's own functions.
+pub const REACTION_TERMS: (&str, [&str; 2]) = ("bodies", ["pressure", "viscosity"]);
+
 /// The pass's term sources, in registry order (appended to the pass's WGSL).
 pub fn wgsl_for(pass: &str) -> impl Iterator<Item = &'static str> + '_ {
     PAIR_TERMS
         .iter()
-        .filter(move |t| t.pass == pass)
+        .filter(move |t| {
+            t.pass == pass || (pass == REACTION_TERMS.0 && REACTION_TERMS.1.contains(&t.name))
+        })
         .map(|t| t.wgsl)
 }
 

@@ -34,6 +34,7 @@ macro_rules! scene_file {
 const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/adiabatic_box"), &[]),
     (scene_file!("validation/conduction_1d"), &[]),
+    (scene_file!("validation/collision_2d"), &[]),
     (scene_file!("validation/conduction_two_materials"), &[]),
     (
         scene_file!("validation/couette_2d"),
@@ -43,6 +44,8 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/dam_break_3d"), &["dx=0.02"]),
     (scene_file!("validation/dam_break_air_2d"), &["dx=0.01"]),
     (scene_file!("validation/dam_break_gate_2d"), &["dx=0.01"]),
+    (scene_file!("validation/flotation_2d"), &["dx=0.02"]),
+    (scene_file!("validation/free_rotation_3d"), &[]),
     (scene_file!("validation/hydrostatic_2d"), &["dx=0.025"]),
     (scene_file!("validation/hydrostatic_3d"), &["dx=0.025"]),
     (scene_file!("validation/jet_outflow_2d"), &[]),

@@ -6,8 +6,10 @@
 //! two_layer.rs (liquid under gas), compression.rs (liquid density), heat.rs
 //! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy),
 //! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
-//! thermocapillary.rs (Marangoni flow in a two-layer channel).
+//! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
+//! bodies: restitution, free rotation).
 
+mod bodies;
 mod compression;
 mod dam_break;
 mod flow;
@@ -139,6 +141,11 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Stefan1d => Box::new(heat::Stefan::default()),
         CheckKind::Rosenthal => Box::new(heat::Rosenthal),
         CheckKind::LaserEnergy => Box::new(heat::LaserEnergy::default()),
+        CheckKind::Restitution => Box::new(bodies::Restitution),
+        CheckKind::Flotation => Box::new(bodies::Flotation),
+        CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
+            c.energy_tolerance.unwrap_or(f64::NAN),
+        )),
     }
 }
 

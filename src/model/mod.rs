@@ -1,6 +1,7 @@
 //! A validated scene: every derived constant the solver needs, checked for physical
 //! sense, plus the host-side time-step limits (F22 (42)).
 
+mod bodies;
 mod domain;
 mod laser;
 mod phases;
@@ -11,6 +12,7 @@ pub use laser::{Laser, MAX_LASER_POINTS};
 pub use phases::{Evaporation, PhaseInfo, TemperatureWave, Thermal};
 pub use tension::SurfaceTension;
 
+pub use bodies::{BodySpec, Contact};
 use domain::{
     box_face_warnings, cell_grid, check_walls, domain_box, domain_sites, hydrostatic_axis,
     open_side_flags,
@@ -44,6 +46,8 @@ pub struct DtLimits {
     /// F22 (42) 0.25 √(ρ h³/(2π α)), the lighter of the pair's ρ0 and the largest
     /// α the scene can reach; ∞ without surface tension.
     pub capillary: f64,
+    /// F22 (42) 0.22 √(m/k_c) with the lightest body particle; ∞ without bodies.
+    pub contact: f64,
 }
 
 impl DtLimits {
@@ -63,6 +67,9 @@ impl DtLimits {
         }
         if self.capillary < best.0 {
             best = (self.capillary, "capillary 0.25 sqrt(rho h^3/(2 pi alpha))");
+        }
+        if self.contact < best.0 {
+            best = (self.contact, "contact 0.22 sqrt(m/k_c)");
         }
         best
     }
@@ -121,6 +128,10 @@ pub struct Model {
     pub surface_tension: Option<SurfaceTension>,
     /// The poured `[powder]` bed.
     pub powder: Option<crate::powder::PowderBed>,
+    /// Rigid bodies, in body order (`shapes` with `body = true`).
+    pub bodies: Vec<BodySpec>,
+    /// F22 (39)–(40) contact between bodies and with walls (scenes with bodies).
+    pub contact: Option<Contact>,
     pub limits: DtLimits,
 }
 
@@ -192,6 +203,10 @@ impl Model {
         let closed = (0..self.dim as usize)
             .any(|a| !self.periodic[a] && self.open_sides[a].iter().any(|open| !open));
         closed && self.phases.iter().any(|p| p.is_fluid())
+    }
+    /// The scene has rigid bodies.
+    pub fn has_bodies(&self) -> bool {
+        !self.bodies.is_empty()
     }
     pub fn is_thermal(&self) -> bool {
         self.phases.iter().any(|p| p.thermal.is_some())
@@ -311,8 +326,12 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     check_walls(&cx, scene, &phases, dim, periodic)?;
 
     let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
-    if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) {
-        return Err(cx.err("phases", "the scene has no liquid, gas or solid phase"));
+    let has_body = scene.shapes.iter().any(|s| s.body);
+    if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) && !has_body {
+        return Err(cx.err(
+            "phases",
+            "the scene has no liquid, gas or solid phase nor a rigid body",
+        ));
     }
     let conduction = phases
         .iter()
@@ -331,6 +350,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     );
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
+    let (bodies, contact) = bodies::bodies(&cx, scene, &phases, dim, periodic)?;
     let surface_tension = tension::surface_tension(&cx, scene, &phases)?;
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
@@ -363,6 +383,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(&phases)))
                 .sqrt()
         }),
+        contact: bodies::contact_limit(scene, &bodies, &phases, contact),
     };
 
     let run = &scene.run;
@@ -503,6 +524,8 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         barrier,
         surface_tension,
         powder,
+        bodies,
+        contact,
         limits,
     })
 }

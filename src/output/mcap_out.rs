@@ -1,6 +1,7 @@
 //! MCAP stream: `/particles` (foxglove.PointCloud, protobuf), `/diagnostics`,
 //! `/removed` (one message per particle leaving the domain) and, in scenes with a
-//! laser and melting, `/track` (one message at the end: crate::track) (JSON with
+//! laser and melting, `/track` (one message at the end: crate::track), in scenes
+//! with rigid bodies `/bodies` (one message per frame) (JSON with
 //! JSON schemas), zstd-compressed chunks, the resolved scenario as
 //! metadata. Every message closes its chunk and flushes, so a process killed hard
 //! leaves a file readable up to its last message; `finish` (or Drop) writes the
@@ -20,6 +21,7 @@ pub const PARTICLES_TOPIC: &str = "/particles";
 pub const DIAGNOSTICS_TOPIC: &str = "/diagnostics";
 pub const REMOVED_TOPIC: &str = "/removed";
 pub const TRACK_TOPIC: &str = "/track";
+pub const BODIES_TOPIC: &str = "/bodies";
 /// Name of the metadata record holding the run's provenance.
 pub const METADATA_NAME: &str = "spatter";
 
@@ -30,6 +32,7 @@ pub struct McapSink {
     diagnostics: u16,
     removed: u16,
     track: Option<u16>,
+    bodies: Option<u16>,
     /// Ids whose removal is written (None until the first state: a resumed run's
     /// earlier removals are in the earlier file).
     reported: Option<std::collections::HashSet<u32>>,
@@ -106,6 +109,21 @@ impl McapSink {
         } else {
             None
         };
+        let bodies = if m.has_bodies() {
+            let schema = w
+                .add_schema(
+                    "spatter.Bodies",
+                    "jsonschema",
+                    bodies_schema().to_string().as_bytes(),
+                )
+                .map_err(|e| err(&e))?;
+            Some(
+                w.add_channel(schema, BODIES_TOPIC, "json", &none)
+                    .map_err(|e| err(&e))?,
+            )
+        } else {
+            None
+        };
         let meta = BTreeMap::from([
             (
                 "spatter_version".to_string(),
@@ -129,6 +147,7 @@ impl McapSink {
             diagnostics,
             removed,
             track,
+            bodies,
             reported: None,
             sequence: 0,
             frames: 0,
@@ -162,6 +181,10 @@ impl McapSink {
         let t = st.sim.time as f64;
         let data = pointcloud::encode_frame(t, &particle_fields(m, st));
         self.write(self.particles, t, &data)?;
+        if let Some(channel) = self.bodies {
+            let json = serde_json::to_vec(&bodies_message(m, st)).map_err(|e| e.to_string())?;
+            self.write(channel, t, &json)?;
+        }
         self.frames += 1;
         self.last_frame_step = Some(st.sim.step);
         Ok(())
@@ -203,6 +226,56 @@ impl McapSink {
         }
         Ok(())
     }
+}
+
+/// A `/bodies` message: every rigid body's motion at one frame.
+fn bodies_message(m: &Model, st: &State) -> serde_json::Value {
+    let bodies: Vec<serde_json::Value> = st
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let mo = crate::bodies::BodyMotion::of(m, b);
+            serde_json::json!({
+                "body": k + 1,
+                "position": mo.position,
+                "orientation": mo.orientation,
+                "velocity": mo.velocity,
+                "angular_velocity": mo.angular_velocity,
+                "mass": mo.mass,
+                "particles": b.count,
+            })
+        })
+        .collect();
+    serde_json::json!({"time": st.sim.time as f64, "bodies": bodies})
+}
+
+/// JSON schema of a `/bodies` message.
+fn bodies_schema() -> serde_json::Value {
+    let vec = |n: usize, desc: &str| serde_json::json!({"type": "array", "items": {"type": "number"}, "minItems": n, "maxItems": n, "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Bodies",
+        "description": "Every rigid body's motion at one frame (issue 17).",
+        "type": "object",
+        "properties": {
+            "time": {"type": "number", "description": "s"},
+            "bodies": {"type": "array", "items": {
+                "type": "object",
+                "properties": {
+                    "body": {"type": "integer", "description": "index + 1, as the frames' `body` channel"},
+                    "position": vec(3, "centre of mass, world coordinates (m)"),
+                    "orientation": vec(4, "unit quaternion (x, y, z, w) from the body's principal frame to world"),
+                    "velocity": vec(3, "of the centre of mass (m/s)"),
+                    "angular_velocity": vec(3, "world frame (rad/s)"),
+                    "mass": {"type": "number", "description": "kg (kg per metre of depth in 2D)"},
+                    "particles": {"type": "integer", "description": "member particles"}
+                },
+                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles"]
+            }}
+        },
+        "required": ["time", "bodies"]
+    })
 }
 
 /// JSON schema of a `/removed` message (crate::outflow::RemovalEvent).

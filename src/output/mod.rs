@@ -61,7 +61,8 @@ pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
 /// pressure (Pa), mass (kg), phase (index into the scene's phases), id (the
 /// particle's index at setup, stable across reordering), and in heat scenes
 /// temperature (K), liquid fraction and specific enthalpy (J/kg); in powder
-/// scenes `grain` (index + 1 of the grain the particle was poured in, 0 none).
+/// scenes `grain` (index + 1 of the grain the particle was poured in, 0 none);
+/// in scenes with rigid bodies `body` (index + 1 of its body, 0 none).
 ///
 /// Frames hold the particles still in the simulation only: the removed ones (the
 /// last `sim.removed` of the state, issue 18) are left out, so they do not hang
@@ -102,6 +103,20 @@ pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
 /// One channel.
 pub fn channel(name: &'static str, values: Values) -> Vec<Field> {
     vec![Field { name, values }]
+}
+
+/// Scenes with rigid bodies: `body`, index + 1 of the body the particle belongs
+/// to (0: none).
+pub fn body_channels(_m: &Model, st: &State) -> Vec<Field> {
+    let body = st
+        .id
+        .iter()
+        .map(|&id| match st.body[id as usize] {
+            crate::state::NO_BODY => 0,
+            b => b + 1,
+        })
+        .collect();
+    channel("body", Values::U32(body))
 }
 
 /// Position channels: world coordinates x, y, z (m).

@@ -2,6 +2,7 @@
 //! Each particle gathers from its own neighbours, so the result does not depend on
 //! the thread count or schedule.
 
+mod bodies;
 mod density;
 mod forces;
 mod heat;
@@ -117,6 +118,17 @@ impl CpuBackend {
     }
     pub(crate) fn timestep(&mut self) {
         timestep::run(&self.params, &mut self.st)
+    }
+    pub(crate) fn body_drift(&mut self) {
+        bodies::drift(&self.params, &mut self.st);
+        bodies::place(&mut self.st);
+    }
+    pub(crate) fn body_forces(&mut self) {
+        bodies::forces(&self.params, &mut self.st, &self.grid);
+        bodies::sum(&mut self.st);
+    }
+    pub(crate) fn body_kick(&mut self) {
+        bodies::kick(&self.params, &mut self.st)
     }
 }
 

@@ -33,7 +33,7 @@ pub fn run(pr: &Params, st: &mut State) {
 
 /// The F22 (42) limit that binds: 0 acoustic, 1 viscous, 2 force, 3 fixed,
 /// 4 conduction (0.1 ρ c_p h²/k, issue 4), 5 barrier (0.22 √(m/k_b)),
-/// 6 capillary (0.25 √(ρ h³/(2π α))). A scene without fluid has no acoustic
+/// 6 capillary (0.25 √(ρ h³/(2π α))), 7 contact (0.22 √(m/k_c)). A scene without fluid has no acoustic
 /// limit (c_max = 0, |u| = 0).
 pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
     let h = pr.kernel.h;
@@ -58,6 +58,10 @@ pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
     if pr.time_step.capillary_limit < dt {
         dt = pr.time_step.capillary_limit;
         which = 6;
+    }
+    if pr.time_step.contact_limit < dt {
+        dt = pr.time_step.contact_limit;
+        which = 7;
     }
     if amax2 > 0.0 {
         let f = 0.25 * (h / amax2.sqrt()).sqrt();

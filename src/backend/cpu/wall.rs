@@ -22,13 +22,14 @@ fn for_each_neighbor_if(
 }
 use crate::kernel;
 use crate::params::{Params, FLAG_PRESSURE_FLOOR};
-use crate::state::State;
+use crate::state::{State, NO_BODY};
 use rayon::prelude::*;
 
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
     let n = st.active();
     let (pos, phase) = (&st.pos, &st.phase);
     let (rho_in, p_in, vel_in) = (&st.rho, &st.press, &st.vel);
+    let (body, bodies, st_id) = (&st.body, &st.bodies, &st.id);
     let out: Vec<Option<(f32, f32, [f32; 4])>> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -57,7 +58,13 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                     sv[a] += v[a] * wk;
                 }
             });
-            let b = pr.phase(ph).velocity;
+            // The wall's own velocity: its phase's, or a body particle's rigid motion.
+            let mut b = pr.phase(ph).velocity;
+            let by_id = body.get(st_id[i] as usize);
+            if let Some(&k) = by_id.filter(|&&k| k != NO_BODY) {
+                let u = super::bodies::point_velocity(&bodies[k as usize], &pos[i]);
+                b = [u[0], u[1], u[2], 0.0];
+            }
             let m = pr.phase(ph);
             // Regularised Shepard division: Σ W + ε instead of Σ W, ε = 1e-9 W(0).
             // At an exact lattice tie a fluid particle sits at the edge of the

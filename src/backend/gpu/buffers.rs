@@ -16,7 +16,7 @@ use wgpu::util::DeviceExt;
 pub const REDUCE_WG: u32 = 256;
 
 /// Group 0, binding by binding, grouped by concern.
-pub const BINDINGS: [&str; 27] = [
+pub const BINDINGS: [&str; 32] = [
     // The parameter block.
     "P",
     // Particle fields (crate::fields).
@@ -51,6 +51,13 @@ pub const BINDINGS: [&str; 27] = [
     "bins",
     "surface",
     "cell_fluid",
+    // Rigid bodies: body and offset by particle id, the body table, the member
+    // lists and the id -> index slots.
+    "body",
+    "body_offset",
+    "bodies",
+    "members",
+    "slots",
 ];
 
 pub fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
@@ -79,6 +86,11 @@ pub struct Buffers {
     pub sort_stages: wgpu::Buffer,
     /// Laser bins (Σ wV, absorbed power); a 16-byte placeholder without a laser.
     pub bins: wgpu::Buffer,
+    /// Rigid bodies: the body table, the member lists, each id's current index
+    /// (16-byte placeholders without bodies).
+    pub bodies: wgpu::Buffer,
+    pub members: wgpu::Buffer,
+    pub slots: wgpu::Buffer,
 }
 
 /// Laser bins in the scene (0 without a laser).
@@ -145,6 +157,17 @@ impl Buffers {
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
             bins: storage(device, "laser bins", laser_bin_count(params) as u64 * 8),
+            bodies: storage(
+                device,
+                "bodies",
+                params.bodies.n_bodies as u64 * std::mem::size_of::<crate::state::Body>() as u64,
+            ),
+            members: storage(
+                device,
+                "members",
+                if held.bodies { n as u64 * 4 } else { 0 },
+            ),
+            slots: storage(device, "slots", if held.bodies { n as u64 * 4 } else { 0 }),
         }
     }
 
@@ -165,6 +188,9 @@ impl Buffers {
             "sim" => &self.sim,
             "partials" => &self.partials,
             "bins" => &self.bins,
+            "bodies" => &self.bodies,
+            "members" => &self.members,
+            "slots" => &self.slots,
             other => panic!("no buffer for binding {other}"),
         }
     }
@@ -176,6 +202,10 @@ impl Buffers {
             if held.holds(f.holder) && !words.is_empty() {
                 queue.write_buffer(buf, 0, bytemuck::cast_slice(words));
             }
+        }
+        if held.bodies {
+            queue.write_buffer(&self.bodies, 0, bytemuck::cast_slice(&st.bodies));
+            queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&st.members));
         }
         queue.write_buffer(&self.sim, 0, bytemuck::bytes_of(&st.sim));
         queue.submit([]);

@@ -36,6 +36,8 @@ pub struct GpuBackend {
     held: Held,
     n: u32,
     n_pad: u32,
+    /// Entries of the body member list (rigid-body scenes).
+    n_members: u64,
     sort_steps: Vec<SortStep>,
     buf: Buffers,
     /// Group 0 per pass file (same buffers, each pass's read-only ones marked).
@@ -54,6 +56,7 @@ impl GpuBackend {
         let held = Held {
             heat: pipeline.features.heat,
             interface: pipeline.features.interface,
+            bodies: pipeline.features.bodies,
         };
         let limit = ctx.limits.max_storage_buffer_binding_size;
         let biggest = buffers::largest_buffer(&params, n, n_pad, held);
@@ -98,6 +101,7 @@ impl GpuBackend {
             held,
             n,
             n_pad,
+            n_members: st.members.len() as u64,
             sort_steps: stages,
             buf,
             binds,
@@ -129,6 +133,7 @@ impl GpuBackend {
             }
             Work::Reduction => self.n.div_ceil(REDUCE_WG),
             Work::Single => 1,
+            Work::Bodies => p.bodies.n_bodies.div_ceil(WG),
             Work::Sort => unreachable!("the bitonic sort is scheduled by encode_neighbors"),
         };
         let (x, y) = grid_for(groups);
@@ -326,6 +331,13 @@ impl Backend for GpuBackend {
                 let bytes = self.n as u64 * f.bytes_per_particle() as u64;
                 (f.set)(&mut st, &self.read_bytes(buf, bytes)?);
             }
+        }
+        if self.held.bodies {
+            let bytes = self.params.bodies.n_bodies as u64
+                * std::mem::size_of::<crate::state::Body>() as u64;
+            st.bodies = bytemuck::pod_collect_to_vec(&self.read_bytes(&self.buf.bodies, bytes)?);
+            let members = self.read_bytes(&self.buf.members, self.n_members * 4)?;
+            st.members = bytemuck::pod_collect_to_vec(&members);
         }
         st.sim = self.read_sim()?;
         Ok(st)

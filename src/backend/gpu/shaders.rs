@@ -22,7 +22,7 @@ use crate::params::Params;
 use std::collections::HashMap;
 
 /// Library files, in the order they are composed (each after what it uses).
-const LIBS: [(&str, &str); 8] = [
+const LIBS: [(&str, &str); 9] = [
     ("params", include_str!("../../../shaders/lib/params.wgsl")),
     (
         "bindings",
@@ -34,10 +34,11 @@ const LIBS: [(&str, &str); 8] = [
     ("grid", include_str!("../../../shaders/lib/grid.wgsl")),
     ("phase", include_str!("../../../shaders/lib/phase.wgsl")),
     ("vapour", include_str!("../../../shaders/lib/vapour.wgsl")),
+    ("rigid", include_str!("../../../shaders/lib/rigid.wgsl")),
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
-pub const PASSES: [(&str, &str); 10] = [
+pub const PASSES: [(&str, &str); 11] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
@@ -51,6 +52,7 @@ pub const PASSES: [(&str, &str); 10] = [
         "surface_forces",
         include_str!("../../../shaders/surface_forces.wgsl"),
     ),
+    ("bodies", include_str!("../../../shaders/bodies.wgsl")),
 ];
 
 const WALK_DIRECTIVE: &str = "#for_each_neighbor(";

@@ -96,7 +96,7 @@ struct OutputArgs {
 
 #[derive(Subcommand)]
 enum BenchKind {
-    /// Fluid-only (3D dam break) and heat (line melt) scenes at several sizes on each
+    /// Fluid-only (3D dam break), heat (line melt) and rigid-body (powder bed) scenes at several sizes on each
     /// available backend; per-pass times and the cost of each optional pass.
     Throughput {
         /// Write the figures as JSON.
@@ -106,7 +106,7 @@ enum BenchKind {
         /// projected time exceeds 4 minutes on the CPU, is skipped and says so).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1e4, 1e5, 1e6, 1e7])]
         sizes: Vec<f64>,
-        /// Scenes: dam_break_3d, line_melt (default both).
+        /// Scenes: dam_break_3d, line_melt, powder_bed (default all).
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<String>,
         /// Size at which each optional pass is costed by running without it (0: never).
@@ -533,13 +533,16 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             "none (not in this scene)".to_string()
         }
     };
-    // The barrier's and the capillary limit only where the scene has them.
+    // The barrier's, capillary and contact limits only where the scene has them.
     let mut barrier = String::new();
     if l.barrier.is_finite() {
         barrier.push_str(&format!(", barrier {}", limit(l.barrier)));
     }
     if l.capillary.is_finite() {
         barrier.push_str(&format!(", capillary {}", limit(l.capillary)));
+    }
+    if l.contact.is_finite() {
+        barrier.push_str(&format!(", contact {}", limit(l.contact)));
     }
     println!(
         "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}{barrier}; binding: {which}",

@@ -79,6 +79,8 @@ pub struct PowderSpec {
     pub diameters: Diameters,
     pub seed: u64,
     pub max_grains: Option<usize>,
+    /// Each grain is a rigid body (`[powder] rigid`).
+    pub rigid: bool,
 }
 
 /// The poured bed.
@@ -486,6 +488,7 @@ pub fn spec(
         diameters,
         seed: def.seed,
         max_grains: def.max_grains,
+        rigid: def.rigid,
     })
 }
 
@@ -537,6 +540,7 @@ mod tests {
                 diameters: d,
                 seed: 1,
                 max_grains: Some(1500),
+                rigid: false,
             },
             3,
         );
@@ -562,6 +566,7 @@ mod tests {
                 diameters: f22_diameters(),
                 seed,
                 max_grains: None,
+                rigid: false,
             },
             dim,
         )

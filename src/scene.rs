@@ -136,6 +136,12 @@ pub struct PowderDef {
     /// where the pour starts; the bed keeps the drawn diameters). Default: pour
     /// until the box is full, levelled at its top.
     pub max_grains: Option<usize>,
+    /// Each grain is a rigid body (F22 §2.2): it moves under gravity, contact
+    /// ([contact] is required) and the fluid's forces. The grains' phase must
+    /// not melt (melting bodies are not built yet). Default: grains fixed in
+    /// place.
+    #[serde(default)]
+    pub rigid: bool,
 }
 
 /// `powder.diameter`: ln d ~ N(ln median, log_sigma²), clipped to [min, max] (m).
@@ -571,6 +577,9 @@ pub struct CheckDef {
     pub area: Option<f64>,
     /// Free rotation: the largest relative change of the rotational energy.
     pub energy_tolerance: Option<f64>,
+    /// Bed at rest: the time (s) after which no body may move (default: half
+    /// the run).
+    pub settle_time: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -631,6 +640,8 @@ pub enum CheckKind {
     /// A body lighter than the liquid floats with the immersed depth Archimedes
     /// gives.
     Flotation,
+    /// Bodies at rest (a poured bed under gravity) stay at rest.
+    BedAtRest,
 }
 
 impl CheckKind {
@@ -657,6 +668,7 @@ impl CheckKind {
             CheckKind::Restitution => "restitution",
             CheckKind::FreeRotation => "free_rotation",
             CheckKind::Flotation => "flotation",
+            CheckKind::BedAtRest => "bed_at_rest",
         }
     }
 }

@@ -5,7 +5,7 @@
 //! ones at the same site, so "gas everywhere, then liquid in a box" works.
 
 use crate::error::InputError;
-use crate::model::Model;
+use crate::model::{BodySource, Model};
 use crate::scene::{SceneFile, ShapeDef};
 use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT, NO_BODY};
 
@@ -267,24 +267,36 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     let mut sites: Vec<[u32; 3]> = Vec::new();
     // Each shape's body (NO_BODY: not a body), and each particle's.
     let mut body_index = vec![NO_BODY; scene.shapes.len()];
+    let mut grain_body = NO_BODY;
     for (k, b) in m.bodies.iter().enumerate() {
-        body_index[b.shape] = k as u32;
+        match b.source {
+            BodySource::Shape(i) => body_index[i] = k as u32,
+            BodySource::Grain(0) => grain_body = k as u32,
+            BodySource::Grain(_) => {}
+        }
     }
     let mut body_of: Vec<u32> = Vec::new();
     for (iz, &(z, wz)) in axes[2].iter().enumerate() {
         for (iy, &(y, wy)) in axes[1].iter().enumerate() {
             for (ix, &(x, wx)) in axes[0].iter().enumerate() {
                 let p = [x, y, z];
+                // The grain at this site: the bed's phase and, rigid, its body.
                 let grain = || {
-                    m.powder
-                        .as_ref()
-                        .filter(|b| b.grain_at(p, m.dim as usize).is_some())
-                        .map(|b| b.spec.phase)
+                    let bed = m.powder.as_ref()?;
+                    let g = bed.grain_at(p, m.dim as usize)?;
+                    let body = if grain_body == NO_BODY {
+                        NO_BODY
+                    } else {
+                        grain_body + g as u32
+                    };
+                    Some((bed.spec.phase, body))
                 };
+                let mut site_body = NO_BODY;
                 let (phase, shape) = if wx || wy || wz {
                     (wall_phase_at(m, scene, p), None)
-                } else if let Some(grain) = grain() {
+                } else if let Some((grain, body)) = grain() {
                     // The bed overrides the shapes (gas everywhere, then powder).
+                    site_body = body;
                     (Some(grain), None)
                 } else {
                     scene
@@ -304,7 +316,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                     }
                 }
                 push_particle(m, &mut st, q, pi);
-                body_of.push(shape.map_or(NO_BODY, |(k, _)| body_index[k]));
+                body_of.push(shape.map_or(site_body, |(k, _)| body_index[k]));
                 let fluid_shape = shape.map(|(_, s)| s).filter(|s| !s.body);
                 if let Some(v) = fluid_shape.and_then(|s| s.velocity.as_ref()) {
                     let last = st.vel.len() - 1;
@@ -317,14 +329,22 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         }
     }
     if m.has_bodies() {
-        for (k, b) in m.bodies.iter().enumerate() {
-            if !body_of.contains(&(k as u32)) {
-                return Err(InputError::new(
-                    &m.file,
-                    &format!("shapes[{}]", b.shape),
+        let mut covered = vec![false; m.bodies.len()];
+        for &b in body_of.iter().filter(|&&b| b != NO_BODY) {
+            covered[b as usize] = true;
+        }
+        if let Some(k) = covered.iter().position(|c| !c) {
+            let (key, what) = match m.bodies[k].source {
+                BodySource::Shape(i) => (
+                    format!("shapes[{i}]"),
                     "this body covers no lattice site (too small, or covered by later shapes)",
-                ));
-            }
+                ),
+                BodySource::Grain(_) => (
+                    "powder.diameter.min".to_string(),
+                    "a grain covers no lattice site at this dx: raise min or refine dx",
+                ),
+            };
+            return Err(InputError::new(&m.file, &key, what));
         }
         crate::bodies::assemble(m, &mut st, &body_of);
     }

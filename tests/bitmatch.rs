@@ -566,3 +566,23 @@ steps = 200
     std::fs::write(&path, text).unwrap();
     assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
 }
+
+/// Issue 17: a bed of 1000 rigid grains (the bed-at-rest scene widened to
+/// 2.4 mm and poured with exactly 1000 grains: 2D, 16–32 µm discs at Δx = 5 µm,
+/// 18 278 particles), 200 steps: contact between grains and with the holder,
+/// per-body sums over 1000 bodies.
+#[test]
+fn powder_bed_of_1000_rigid_grains_200_steps() {
+    let sets = [
+        "domain.max=[2.4e-3, 3.5e-4]",
+        "powder.box={min = [0.0, 0.0], max = [2.4e-3, 1.0e-4]}",
+        "powder.max_grains=1000",
+    ];
+    let l = load(
+        &common::scene("powder_bed_at_rest_2d"),
+        &sets.map(String::from),
+    )
+    .unwrap();
+    assert_eq!(l.state.bodies.len(), 1000);
+    assert_bit_identical("powder_bed_at_rest_2d", &sets, 200);
+}

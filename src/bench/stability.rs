@@ -62,6 +62,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         scene_file!("validation/poiseuille_2d"),
         &["dx=6.666666666666667e-5"],
     ),
+    (scene_file!("validation/powder_bed_at_rest_2d"), &[]),
     (scene_file!("validation/recoil_layer_2d"), &[]),
     (scene_file!("validation/rosenthal_2d"), &["dx=5e-5"]),
     (scene_file!("validation/sessile_drop_2d"), &[]),

@@ -1,5 +1,6 @@
-//! `spatter bench throughput`: a fluid-only scene (the 3D dam break) and a heat
-//! scene (the PBF line melt: conduction, laser, melting) at sizes from 1e4 up to
+//! `spatter bench throughput`: a fluid-only scene (the 3D dam break), a heat
+//! scene (the PBF line melt: conduction, laser, melting) and a rigid-body scene
+//! (F22's 500-grain bed, every grain a body in contact) at sizes from 1e4 up to
 //! 1e7 particles where memory and time allow, on each backend. Reports
 //! particle-steps/s (GPUSPH's MIPPS unit ×1e6), pair interactions/s (DualSPHysics'
 //! PIPS), per-pass milliseconds and memory per particle; then, at one size, what
@@ -26,7 +27,7 @@ struct BenchScene {
     text: &'static str,
 }
 
-const SCENES: [BenchScene; 2] = [
+const SCENES: [BenchScene; 3] = [
     BenchScene {
         name: "dam_break_3d",
         kind: "fluid-only",
@@ -39,11 +40,19 @@ const SCENES: [BenchScene; 2] = [
         label: "scenarios/pbf/line_melt_bare_plate.toml",
         text: include_str!("../../scenarios/pbf/line_melt_bare_plate.toml"),
     },
+    BenchScene {
+        name: "powder_bed",
+        kind: "rigid bodies",
+        label: "scenarios/bench/powder_bed_rigid_3d.toml",
+        text: include_str!("../../scenarios/bench/powder_bed_rigid_3d.toml"),
+    },
 ];
 
 /// Stages a scene may or may not have: the ones whose cost is measured by leaving
 /// them out.
-const OPTIONAL: [Stage; 6] = [
+const OPTIONAL: [Stage; 8] = [
+    Stage::BodyDrift,
+    Stage::BodyForces,
     Stage::Wall,
     Stage::Interface,
     Stage::SurfaceForces,
@@ -121,8 +130,8 @@ fn load_at(s: &BenchScene, dx: f64) -> Result<Loaded, SpatterError> {
     )?)
 }
 
-/// Δx that gives about `target` particles: scaled by the cube root of the count
-/// ratio, from a count computed without generating the particles when possible.
+/// Δx that gives about `target` particles: scaled by the count ratio's root of
+/// the scene's dimension.
 fn scene_of_size(s: &BenchScene, target: f64) -> Result<Loaded, SpatterError> {
     let (sc, resolved) = scene::parse_str(s.label, s.text, &[])?;
     let mut dx = model::build(s.label, &sc, &resolved)?.dx;
@@ -132,7 +141,7 @@ fn scene_of_size(s: &BenchScene, target: f64) -> Result<Loaded, SpatterError> {
         if (ratio - 1.0).abs() < 0.1 {
             break;
         }
-        dx *= ratio.cbrt();
+        dx *= ratio.powf(1.0 / l.model.dim as f64);
         l = load_at(s, dx)?;
     }
     Ok(l)

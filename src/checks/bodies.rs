@@ -249,6 +249,86 @@ impl super::Check for Flotation {
     }
 }
 
+/// Bodies at rest stay at rest: every body's centre at the first sample past
+/// `settle_time` (default half the run) against the end; the metric is the
+/// largest displacement in Δx. (Before it, lattice-filled grains close the gaps
+/// their discretisation leaves and ring down.)
+#[derive(Default)]
+pub struct AtRest {
+    pub settle_time: Option<f64>,
+    /// Centres at the reference sample and its time.
+    reference: Option<(f64, Vec<[f64; 3]>)>,
+    /// The largest displacement over the first half (how much it settled).
+    settling: f64,
+    first: Option<Vec<[f64; 3]>>,
+}
+
+impl AtRest {
+    pub fn new(settle_time: Option<f64>) -> AtRest {
+        AtRest {
+            settle_time,
+            ..Default::default()
+        }
+    }
+    fn centres(st: &State) -> Vec<[f64; 3]> {
+        st.bodies
+            .iter()
+            .map(|b| [b.x[0] as f64, b.x[1] as f64, b.x[2] as f64])
+            .collect()
+    }
+}
+
+fn largest_move(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| ((0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>()).sqrt())
+        .fold(0.0, f64::max)
+}
+
+impl super::Check for AtRest {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let half = match (self.settle_time, m.end) {
+            (Some(t), _) => st.sim.time as f64 >= t,
+            (None, crate::model::EndCondition::Time(t)) => st.sim.time as f64 >= 0.5 * t,
+            (None, crate::model::EndCondition::Steps(n)) => st.sim.step as u64 >= n / 2,
+        };
+        if self.first.is_none() {
+            self.first = Some(Self::centres(st));
+        }
+        if half && self.reference.is_none() {
+            let c = Self::centres(st);
+            self.settling = largest_move(self.first.as_ref().unwrap(), &c);
+            self.reference = Some((st.sim.time as f64, c));
+        }
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let metric = "largest body displacement after settling / dx".to_string();
+        let Some((t0, reference)) = &self.reference else {
+            return (
+                metric,
+                f64::NAN,
+                vec!["no sample past the settling time".into()],
+            )
+                .into();
+        };
+        let moved = largest_move(reference, &Self::centres(st)) / m.dx;
+        let details = vec![format!(
+            "at rest: {} bodies; settling moved them up to {:.3} dx; from t = {t0:.4e} s to the end (t = {:.4e} s, step {}) up to {moved:.4} dx",
+            st.bodies.len(),
+            self.settling / m.dx,
+            st.sim.time,
+            st.sim.step
+        )];
+        Verdict {
+            metric,
+            value: moved,
+            details,
+            figures: vec![("settling_dx".into(), self.settling / m.dx)],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     /// Without damping the bounce is elastic; the unclipped dashpot's

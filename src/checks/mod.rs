@@ -143,6 +143,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::LaserEnergy => Box::new(heat::LaserEnergy::default()),
         CheckKind::Restitution => Box::new(bodies::Restitution),
         CheckKind::Flotation => Box::new(bodies::Flotation),
+        CheckKind::BedAtRest => Box::new(bodies::AtRest::new(c.settle_time)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -13,13 +13,23 @@ pub struct Contact {
     pub damping: f64,
 }
 
-/// One body as the scene declares it: the shape its particles come from and its
-/// initial velocity and angular velocity (world frame, rad/s).
+/// One body as the scene declares it: where its particles come from (a shape,
+/// or a grain of a rigid `[powder]` bed), its phase and its initial velocity and
+/// angular velocity (world frame, rad/s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodySpec {
-    pub shape: usize,
+    pub source: BodySource,
+    pub phase: usize,
     pub velocity: [f64; 3],
     pub angular_velocity: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodySource {
+    /// `shapes[i]` with `body = true`.
+    Shape(usize),
+    /// Grain g of the rigid powder bed.
+    Grain(usize),
 }
 
 /// The body shapes and `[contact]`, validated. Bodies are made of a wall or solid
@@ -32,6 +42,7 @@ pub(super) fn bodies(
     phases: &[PhaseInfo],
     dim: u32,
     periodic: [bool; 3],
+    powder: Option<&crate::powder::PowderBed>,
 ) -> Result<(Vec<BodySpec>, Option<Contact>), InputError> {
     let mut specs = Vec::new();
     for (i, s) in scene.shapes.iter().enumerate() {
@@ -45,36 +56,10 @@ pub(super) fn bodies(
             }
             continue;
         }
-        let Some(ph) = phases.iter().find(|p| p.name == s.phase) else {
+        let Some(phase) = phases.iter().position(|p| p.name == s.phase) else {
             continue; // setup names the unknown phase
         };
-        if !matches!(ph.kind, PhaseKind::Wall | PhaseKind::Solid) {
-            return Err(cx.err(
-                &key("body"),
-                format!(
-                    "a rigid body is made of a wall or solid phase; `{}` flows",
-                    s.phase
-                ),
-            ));
-        }
-        if ph.switch_to.is_some() {
-            return Err(cx.err(
-                &key("body"),
-                format!(
-                    "phase `{}` melts: melting rigid bodies are not supported yet",
-                    s.phase
-                ),
-            ));
-        }
-        if ph.moves {
-            return Err(cx.err(
-                &key("body"),
-                format!(
-                    "phase `{}` moves with a prescribed velocity; a body moves by its forces",
-                    s.phase
-                ),
-            ));
-        }
+        body_phase(cx, &key("body"), &phases[phase])?;
         let velocity = match &s.velocity {
             Some(v) => cx.vector(&key("velocity"), v, dim)?,
             None => [0.0; 3],
@@ -88,10 +73,22 @@ pub(super) fn bodies(
             None => [0.0; 3],
         };
         specs.push(BodySpec {
-            shape: i,
+            source: BodySource::Shape(i),
+            phase,
             velocity,
             angular_velocity,
         });
+    }
+    if let Some(bed) = powder.filter(|b| b.spec.rigid) {
+        body_phase(cx, "powder.rigid", &phases[bed.spec.phase])?;
+        for g in 0..bed.grains.len() {
+            specs.push(BodySpec {
+                source: BodySource::Grain(g),
+                phase: bed.spec.phase,
+                velocity: [0.0; 3],
+                angular_velocity: [0.0; 3],
+            });
+        }
     }
     let contact = match &scene.contact {
         Some(c) => Some(Contact {
@@ -117,10 +114,34 @@ pub(super) fn bodies(
     Ok((specs, contact))
 }
 
+/// A body's phase: a wall or solid that does not melt and has no prescribed
+/// motion.
+fn body_phase(cx: &Ctx, key: &str, ph: &PhaseInfo) -> Result<(), InputError> {
+    let name = &ph.name;
+    if !matches!(ph.kind, PhaseKind::Wall | PhaseKind::Solid) {
+        return Err(cx.err(
+            key,
+            format!("a rigid body is made of a wall or solid phase; `{name}` flows"),
+        ));
+    }
+    if ph.switch_to.is_some() {
+        return Err(cx.err(
+            key,
+            format!("phase `{name}` melts: melting rigid bodies are not supported yet"),
+        ));
+    }
+    if ph.moves {
+        return Err(cx.err(
+            key,
+            format!("phase `{name}` moves with a prescribed velocity; a body moves by its forces"),
+        ));
+    }
+    Ok(())
+}
+
 /// F22 (42): 0.22 √(m/k_c) with the lightest particle of any body (∞ without
 /// bodies).
 pub(super) fn contact_limit(
-    scene: &SceneFile,
     specs: &[BodySpec],
     phases: &[PhaseInfo],
     contact: Option<Contact>,
@@ -130,11 +151,6 @@ pub(super) fn contact_limit(
     };
     specs
         .iter()
-        .filter_map(|b| {
-            phases
-                .iter()
-                .find(|p| p.name == scene.shapes[b.shape].phase)
-        })
-        .map(|p| 0.22 * (p.mass / c.stiffness).sqrt())
+        .map(|b| 0.22 * (phases[b.phase].mass / c.stiffness).sqrt())
         .fold(f64::INFINITY, f64::min)
 }

@@ -12,7 +12,7 @@ pub use laser::{Laser, MAX_LASER_POINTS};
 pub use phases::{Evaporation, PhaseInfo, TemperatureWave, Thermal};
 pub use tension::SurfaceTension;
 
-pub use bodies::{BodySpec, Contact};
+pub use bodies::{BodySource, BodySpec, Contact};
 use domain::{
     box_face_warnings, cell_grid, check_walls, domain_box, domain_sites, hydrostatic_axis,
     open_side_flags,
@@ -326,7 +326,8 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     check_walls(&cx, scene, &phases, dim, periodic)?;
 
     let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
-    let has_body = scene.shapes.iter().any(|s| s.body);
+    let has_body =
+        scene.shapes.iter().any(|s| s.body) || scene.powder.as_ref().is_some_and(|p| p.rigid);
     if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) && !has_body {
         return Err(cx.err(
             "phases",
@@ -350,7 +351,8 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     );
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
-    let (bodies, contact) = bodies::bodies(&cx, scene, &phases, dim, periodic)?;
+    let powder = powder_bed(&cx, scene, dim, &phases)?;
+    let (bodies, contact) = bodies::bodies(&cx, scene, &phases, dim, periodic, powder.as_ref())?;
     let surface_tension = tension::surface_tension(&cx, scene, &phases)?;
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
@@ -383,7 +385,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(&phases)))
                 .sqrt()
         }),
-        contact: bodies::contact_limit(scene, &bodies, &phases, contact),
+        contact: bodies::contact_limit(&bodies, &phases, contact),
     };
 
     let run = &scene.run;
@@ -459,7 +461,6 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
-    let powder = powder_bed(&cx, scene, dim, &phases)?;
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
@@ -548,7 +549,7 @@ fn powder_bed(
     if !matches!(phases[phase].kind, PhaseKind::Solid | PhaseKind::Wall) {
         return Err(cx.err(
             "powder.phase",
-            format!("`{}` must be a solid or wall phase: grains are fixed in place until rigid bodies exist", def.phase),
+            format!("`{}` must be a solid or wall phase", def.phase),
         ));
     }
     let spec = crate::powder::spec(cx.file, def, phase, dim as usize)?;

@@ -267,6 +267,26 @@ pub fn assemble(m: &Model, st: &mut State, body_of: &[u32]) {
     }
 }
 
+/// Rigid powder grains ejected from the bed: (ejected, grains), a grain counting
+/// when its centre is more than its own diameter above the bed's initial top
+/// (issue 17 item 6). None without a rigid bed.
+pub fn ejected_grains(m: &Model, st: &State) -> Option<(usize, usize)> {
+    let bed = m.powder.as_ref().filter(|b| b.spec.rigid)?;
+    let up = m.dim as usize - 1;
+    let top = bed.spec.lo[up] + bed.thickness;
+    let mut ejected = 0;
+    for (k, spec) in m.bodies.iter().enumerate() {
+        let crate::model::BodySource::Grain(g) = spec.source else {
+            continue;
+        };
+        let height = st.bodies[k].x[up] as f64 + m.origin[up];
+        if height > top + 2.0 * bed.grains[g].radius {
+            ejected += 1;
+        }
+    }
+    Some((ejected, bed.grains.len()))
+}
+
 /// A body's motion in world terms, f64, for outputs and checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyMotion {

@@ -348,6 +348,11 @@ fn cmd_run(
             println!("{line}");
         }
     }
+    if let Some((ejected, grains)) =
+        spatter::bodies::ejected_grains(&loaded.model, &report.final_state)
+    {
+        println!("powder: of {grains} rigid grains {ejected} ejected (centre more than a diameter above the bed's initial top)");
+    }
     if loaded.model.has_walls_and_fluid() {
         println!("wall leakage: {}", report.leakage.summary());
     }

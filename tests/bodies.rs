@@ -197,3 +197,34 @@ fn powder_bed_stays_at_rest() {
     let line = out.lines().find(|l| l.starts_with("at rest:")).unwrap();
     assert!(line.contains("180 bodies"), "{line}");
 }
+
+/// Ejected grains (issue 17 item 6): with gravity turned upwards the whole bed
+/// lifts off, and every grain ends more than its diameter above the bed's
+/// initial top; at rest none does.
+#[test]
+fn ejected_grains_are_counted() {
+    let count = |sets: &[&str]| -> String {
+        let path = scene("powder_bed_at_rest_2d");
+        let mut args = vec!["run", &path, "--backend", "cpu", "--steps", "600"];
+        for s in sets {
+            args.extend_from_slice(&["--set", s]);
+        }
+        let out = spatter(&args);
+        let (stdout, _) = text(&out);
+        stdout
+            .lines()
+            .find(|l| l.starts_with("powder: of "))
+            .unwrap_or_else(|| panic!("{stdout}"))
+            .to_string()
+    };
+    let up = count(&["gravity=[0.0, 2000.0]"]);
+    assert!(
+        up.starts_with("powder: of 180 rigid grains 180 ejected"),
+        "{up}"
+    );
+    let rest = count(&[]);
+    assert!(
+        rest.starts_with("powder: of 180 rigid grains 0 ejected"),
+        "{rest}"
+    );
+}

@@ -157,10 +157,13 @@ impl Buffers {
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
             bins: storage(device, "laser bins", laser_bin_count(params) as u64 * 8),
+            // At least one entry: the wall pass declares the table, and a binding
+            // must hold one element of it (128 bytes) even where no body exists.
             bodies: storage(
                 device,
                 "bodies",
-                params.bodies.n_bodies as u64 * std::mem::size_of::<crate::state::Body>() as u64,
+                params.bodies.n_bodies.max(1) as u64
+                    * std::mem::size_of::<crate::state::Body>() as u64,
             ),
             members: storage(
                 device,

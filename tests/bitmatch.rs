@@ -482,11 +482,7 @@ angular_velocity = [1.0]
 [run]
 steps = 200
 "#;
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_bodies");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bodies_tank_2d.toml");
-    std::fs::write(&path, text).unwrap();
-    assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
+    assert_bit_identical_text("bodies_tank_2d", text, 200);
 }
 
 /// Issue 17: rigid bodies in 3D, 200 steps: a tumbling block hits a sphere, a
@@ -560,11 +556,16 @@ angular_velocity = [0.0, 1.0, 0.0]
 [run]
 steps = 200
 "#;
+    assert_bit_identical_text("bodies_3d", text, 200);
+}
+
+/// The same for a scene given as TOML text (written to a scratch file `name`).
+fn assert_bit_identical_text(name: &str, text: &str, steps: u64) {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_bodies");
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bodies_3d.toml");
+    let path = dir.join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
+    assert_bit_identical_at(path.to_str().unwrap(), &[], steps);
 }
 
 /// Issue 17: a bed of 1000 rigid grains (the bed-at-rest scene widened to

@@ -141,6 +141,22 @@ fn bad_body_input_exits_2_naming_the_key() {
         "domain.periodic",
     );
     assert_input_error(&["validate", &s, "--set", "run.dt=0.01"], "run.dt");
+    // Rigid grains of a phase that melts (the coarse PBF bed's plate).
+    let pbf = format!(
+        "{}/scenarios/pbf/powder_bed_line_melt_coarse_2d.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    assert_input_error(
+        &[
+            "validate",
+            &pbf,
+            "--set",
+            "powder.rigid=true",
+            "--set",
+            "contact={stiffness = 1.0e4, damping = 0.06}",
+        ],
+        "powder.rigid",
+    );
     assert_input_error(
         &["validate", &s, "--set", "contact.stiffness=-1.0"],
         "contact.stiffness",

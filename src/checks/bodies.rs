@@ -144,7 +144,7 @@ impl super::Check for FreeRotation {
         }
     }
 
-    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+    fn verdict(&mut self, _m: &Model, st: &State) -> Verdict {
         let metric = "max |L - L0| / |L0| (world angular momentum)".to_string();
         let Some(b) = st.bodies.first() else {
             return (metric, f64::NAN, vec!["needs a rigid body".into()]).into();
@@ -168,7 +168,6 @@ impl super::Check for FreeRotation {
             details.push("started about the intermediate axis but never flipped".into());
             value = f64::INFINITY;
         }
-        let _ = m;
         Verdict {
             metric,
             value,

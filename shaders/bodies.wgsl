@@ -1,5 +1,5 @@
 // uses: params bindings consts kernel grid phase rigid
-// writes: pos acc bodies slots
+// writes: pos vel acc acc_b body body_offset bodies members slots
 // Rigid bodies (F22 2.2, 3.4) in the kick-drift-kick step: half kicks of V and
 // the world angular momentum L, drift, free rotation split into exact turns
 // about the principal axes, members placed at X + R r0; F22 (39)-(40) contact
@@ -41,7 +41,7 @@ fn turn(b0: Body, k: u32, tau: f32) -> Body {
 @compute @workgroup_size(64)
 fn body_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = thread_index(gid, nwg);
-    if (k >= P.bodies.n_bodies) { return; }
+    if (k >= P.bodies.n_bodies || !body_moves(bodies[k])) { return; }
     let dt = sim.dt;
     let h = c_half() * dt;
     var b = kick_body(bodies[k], h);
@@ -155,7 +155,7 @@ fn body_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(64)
 fn body_sum(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = thread_index(gid, nwg);
-    if (k >= P.bodies.n_bodies) { return; }
+    if (k >= P.bodies.n_bodies || !body_moves(bodies[k])) { return; }
     var b = bodies[k];
     var f = vec3<f32>(0.0);
     var t = vec3<f32>(0.0);
@@ -178,6 +178,283 @@ fn body_sum(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
 @compute @workgroup_size(64)
 fn body_kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = thread_index(gid, nwg);
-    if (k >= P.bodies.n_bodies) { return; }
+    if (k >= P.bodies.n_bodies || !body_moves(bodies[k])) { return; }
     bodies[k] = kick_body(bodies[k], c_half() * sim.dt);
+}
+
+// A particle that solidified in this step (BODY_SOLIDIFIED, from the temperature
+// pass) flags every body particle within 1.5 dx (body_offset.w = 1; threads that
+// flag the same particle write the same value) and is NO_BODY again.
+@compute @workgroup_size(64)
+fn body_bond(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    if (body[id[i]] != BODY_SOLIDIFIED) { return; }
+    body[id[i]] = NO_BODY;
+    let pi = pos[i];
+    let reach = c_one_and_half() * P.bodies.contact_distance;
+    let reach2 = reach * reach;
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        if (len2(d) < reach2 && body[id[j]] < P.bodies.n_bodies) {
+            body_offset[id[j]].w = c_one();
+        }
+    }
+}
+
+// A melted member leaves body b: a fluid particle with b's material velocity,
+// taking its own force f (in acc) with it as the acceleration f/m; returns f.
+fn release(b: Body, m_id: u32, i: u32) -> vec3<f32> {
+    let u = body_point_velocity(b, pos[i]);
+    let f = acc[i].xyz;
+    let m = mass[i];
+    vel[i] = vec4<f32>(u, vel[i].w);
+    acc[i] = vec4<f32>(f.x / m, f.y / m, f.z / m, 0.0);
+    acc_b[i] = vec4<f32>(0.0);
+    body[m_id] = NO_BODY;
+    return f;
+}
+
+// Body k bonds into the substrate: melted members leave, the rest stay put as
+// fixed solid particles and stay listed (count, their mass); bonded stops every
+// body pass.
+fn bond_body(k: u32) {
+    var b = bodies[k];
+    var kept = 0u;
+    var m_new = 0.0;
+    for (var m = b.first; m < b.first + b.count; m++) {
+        let m_id = members[m];
+        let i = slots[m_id];
+        body[m_id] = NO_BODY;
+        if (!is_wall(phase[i])) {
+            // Its force leaves with it; the rest goes into the substrate.
+            let f = release(b, m_id, i);
+            continue;
+        }
+        members[b.first + kept] = m_id;
+        kept++;
+        m_new = m_new + mass[i];
+        vel[i] = vec4<f32>(0.0, 0.0, 0.0, vel[i].w);
+        acc[i] = vec4<f32>(0.0);
+        acc_b[i] = vec4<f32>(0.0);
+    }
+    b.count = kept;
+    b.x.w = m_new;
+    b.bonded = 1u;
+    b.v = vec4<f32>(0.0);
+    b.l = vec4<f32>(0.0);
+    b.force = vec4<f32>(0.0);
+    b.torque = vec4<f32>(0.0);
+    bodies[k] = b;
+}
+
+fn mat_mul(a: array<vec3<f32>, 3>, b: array<vec3<f32>, 3>) -> array<vec3<f32>, 3> {
+    var c: array<vec3<f32>, 3>;
+    for (var i = 0u; i < 3u; i++) {
+        for (var j = 0u; j < 3u; j++) {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+        }
+    }
+    return c;
+}
+
+fn transpose3(a: array<vec3<f32>, 3>) -> array<vec3<f32>, 3> {
+    var t: array<vec3<f32>, 3>;
+    for (var i = 0u; i < 3u; i++) {
+        for (var j = 0u; j < 3u; j++) {
+            t[i][j] = a[j][i];
+        }
+    }
+    return t;
+}
+
+fn identity3() -> array<vec3<f32>, 3> {
+    return array<vec3<f32>, 3>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+}
+
+struct Eigen {
+    moments: vec3<f32>,
+    axes: array<vec3<f32>, 3>,   // rows; the axes are the columns
+}
+
+// Cyclic Jacobi rotations with the algebraic angle (square roots only), 6 sweeps;
+// twin of backend::cpu::bodies::jacobi (the reasoning is there).
+fn jacobi(a0: array<vec3<f32>, 3>) -> Eigen {
+    var a = a0;
+    var q = identity3();
+    for (var sweep = 0u; sweep < 6u; sweep++) {
+        for (var pair = 0u; pair < 3u; pair++) {
+            let p = select(0u, 1u, pair == 2u);
+            let r = select(1u, 2u, pair != 0u);
+            let apr = a[p][r];
+            if (abs(apr) <= c_jacobi_floor() * (abs(a[p][p]) + abs(a[r][r]))) { continue; }
+            let theta = (a[r][r] - a[p][p]) / (apr + apr);
+            let t_abs = c_one() / (abs(theta) + sqrt(theta * theta + c_one()));
+            let t = select(t_abs, -t_abs, theta < 0.0);
+            let c = c_one() / sqrt(t * t + c_one());
+            let s = t * c;
+            var g = identity3();
+            g[p][p] = c;
+            g[r][r] = c;
+            g[p][r] = s;
+            g[r][p] = -s;
+            a = mat_mul(transpose3(g), mat_mul(a, g));
+            a[p][r] = 0.0;
+            a[r][p] = 0.0;
+            q = mat_mul(q, g);
+        }
+    }
+    return Eigen(vec3<f32>(a[0][0], a[1][1], a[2][2]), q);
+}
+
+fn normalized4(q: vec4<f32>) -> vec4<f32> {
+    let n = sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    return vec4<f32>(q.x / n, q.y / n, q.z / n, q.w / n);
+}
+
+// The unit quaternion of a rotation matrix (Shepperd), twin of
+// backend::cpu::bodies::quaternion_of.
+fn quaternion_of(r: array<vec3<f32>, 3>) -> vec4<f32> {
+    let t = r[0][0] + r[1][1] + r[2][2];
+    var q: vec4<f32>;
+    if (t > max(max(r[0][0], r[1][1]), r[2][2])) {
+        let w = c_half() * sqrt(c_one() + t);
+        let f = c_quarter() / w;
+        q = vec4<f32>((r[2][1] - r[1][2]) * f, (r[0][2] - r[2][0]) * f, (r[1][0] - r[0][1]) * f, w);
+    } else if (r[0][0] >= r[1][1] && r[0][0] >= r[2][2]) {
+        let x = c_half() * sqrt(c_one() + r[0][0] - r[1][1] - r[2][2]);
+        let f = c_quarter() / x;
+        q = vec4<f32>(x, (r[0][1] + r[1][0]) * f, (r[0][2] + r[2][0]) * f, (r[2][1] - r[1][2]) * f);
+    } else if (r[1][1] >= r[2][2]) {
+        let y = c_half() * sqrt(c_one() - r[0][0] + r[1][1] - r[2][2]);
+        let f = c_quarter() / y;
+        q = vec4<f32>((r[0][1] + r[1][0]) * f, y, (r[1][2] + r[2][1]) * f, (r[0][2] - r[2][0]) * f);
+    } else {
+        let z = c_half() * sqrt(c_one() - r[0][0] - r[1][1] + r[2][2]);
+        let f = c_quarter() / z;
+        q = vec4<f32>((r[0][2] + r[2][0]) * f, (r[1][2] + r[2][1]) * f, z, (r[1][0] - r[0][1]) * f);
+    }
+    return normalized4(q);
+}
+
+// Body k sheds its melted members (F22 (37)); twin of backend::cpu::bodies::shed.
+fn shed(k: u32) {
+    let b = bodies[k];
+    var kept = 0u;
+    var m_new = 0.0;
+    var s = vec3<f32>(0.0);
+    // The force and torque (about the old centre) of the members that stay.
+    var f = b.force.xyz;
+    var tq = b.torque.xyz;
+    for (var m = b.first; m < b.first + b.count; m++) {
+        let m_id = members[m];
+        let i = slots[m_id];
+        if (!is_wall(phase[i])) {
+            let x = pos[i];
+            let fk = release(b, m_id, i);
+            let r = vec3<f32>(x.x - b.x.x, x.y - b.x.y, x.z - b.x.z);
+            f = vec3<f32>(f.x - fk.x, f.y - fk.y, f.z - fk.z);
+            tq = vec3<f32>(
+                tq.x - r.y * fk.z + r.z * fk.y,
+                tq.y - r.z * fk.x + r.x * fk.z,
+                tq.z - r.x * fk.y + r.y * fk.x);
+            continue;
+        }
+        members[b.first + kept] = m_id;
+        kept++;
+        let mi = mass[i];
+        let r0 = body_offset[m_id];
+        m_new = m_new + mi;
+        for (var c = 0u; c < 3u; c++) {
+            s[c] = s[c] + mi * r0[c];
+        }
+    }
+    var nb = b;
+    nb.count = kept;
+    if (kept == 0u) {
+        nb.x.w = 0.0;
+        nb.v = vec4<f32>(0.0);
+        nb.l = vec4<f32>(0.0);
+        nb.force = vec4<f32>(0.0);
+        nb.torque = vec4<f32>(0.0);
+        bodies[k] = nb;
+        return;
+    }
+    let c0 = vec3<f32>(s.x / m_new, s.y / m_new, s.z / m_new);
+    let ip = b.inertia.w;
+    var a: array<vec3<f32>, 3>;
+    for (var m = b.first; m < b.first + kept; m++) {
+        let m_id = members[m];
+        let mi = mass[slots[m_id]];
+        let o = body_offset[m_id];
+        let r = vec3<f32>(o.x - c0.x, o.y - c0.y, o.z - c0.z);
+        let r2 = r.x * r.x + r.y * r.y + r.z * r.z;
+        for (var p = 0u; p < 3u; p++) {
+            a[p][p] = a[p][p] + mi * (ip + r2 - r[p] * r[p]);
+        }
+        a[0][1] = a[0][1] - mi * (r.x * r.y);
+        a[0][2] = a[0][2] - mi * (r.x * r.z);
+        a[1][2] = a[1][2] - mi * (r.y * r.z);
+    }
+    a[1][0] = a[0][1];
+    a[2][0] = a[0][2];
+    a[2][1] = a[1][2];
+    let e = jacobi(a);
+    let axes = e.axes;
+    for (var m = b.first; m < b.first + kept; m++) {
+        let m_id = members[m];
+        let o = body_offset[m_id];
+        let r = vec3<f32>(o.x - c0.x, o.y - c0.y, o.z - c0.z);
+        var t: vec3<f32>;
+        for (var j = 0u; j < 3u; j++) {
+            t[j] = axes[0][j] * r.x + axes[1][j] * r.y + axes[2][j] * r.z;
+        }
+        body_offset[m_id] = vec4<f32>(t, 0.0);
+    }
+    let w = body_angular_velocity(b);
+    let cw = quat_rotate(b.q, c0);
+    let q = normalized4(quat_mul(b.q, quaternion_of(axes)));
+    let lb = quat_rotate(quat_conj(q), w);
+    let l = quat_rotate(q, vec3<f32>(lb.x * e.moments.x, lb.y * e.moments.y, lb.z * e.moments.z));
+    nb.x = vec4<f32>(b.x.x + cw.x, b.x.y + cw.y, b.x.z + cw.z, m_new);
+    nb.q = q;
+    nb.v = vec4<f32>(
+        b.v.x + w.y * cw.z - w.z * cw.y,
+        b.v.y + w.z * cw.x - w.x * cw.z,
+        b.v.z + w.x * cw.y - w.y * cw.x,
+        0.0);
+    nb.l = vec4<f32>(l, 0.0);
+    nb.inertia = vec4<f32>(e.moments, ip);
+    nb.force = vec4<f32>(f, 0.0);
+    nb.torque = vec4<f32>(
+        tq.x - cw.y * f.z + cw.z * f.y,
+        tq.y - cw.z * f.x + cw.x * f.z,
+        tq.z - cw.x * f.y + cw.y * f.x,
+        0.0);
+    bodies[k] = nb;
+}
+
+// F22 (37) and the bonding rule per body (backend::cpu::bodies::melt says how):
+// a body touched by solidifying melt bonds into the substrate, otherwise its
+// melted members leave.
+@compute @workgroup_size(64)
+fn body_melt(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = thread_index(gid, nwg);
+    if (k >= P.bodies.n_bodies) { return; }
+    let b = bodies[k];
+    if (!body_moves(b)) { return; }
+    var melted = false;
+    var touched = false;
+    for (var m = b.first; m < b.first + b.count; m++) {
+        let m_id = members[m];
+        melted = melted || !is_wall(phase[slots[m_id]]);
+        touched = touched || body_offset[m_id].w > 0.0;
+    }
+    if (touched) {
+        bond_body(k);
+    } else if (melted) {
+        shed(k);
+    }
 }

@@ -1,5 +1,5 @@
 // uses: params bindings consts kernel grid phase math vapour
-// writes: acc acc_b heat phase vel
+// writes: acc acc_b heat phase vel body
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
@@ -157,5 +157,9 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         vel[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         acc[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         acc_b[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        // Rigid bodies: body_bond bonds the bodies this particle touches.
+        if ((P.sizes.flags & FLAG_BODIES) != 0u) {
+            body[id[i]] = BODY_SOLIDIFIED;
+        }
     }
 }

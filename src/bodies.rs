@@ -255,13 +255,18 @@ pub fn assemble(m: &Model, st: &mut State, body_of: &[u32]) {
                 0.0,
             ],
             l: [l[0] as f32, l[1] as f32, l[2] as f32, 0.0],
-            inertia: [moments[0] as f32, moments[1] as f32, moments[2] as f32, 0.0],
+            inertia: [
+                moments[0] as f32,
+                moments[1] as f32,
+                moments[2] as f32,
+                ip as f32,
+            ],
             force: [0.0; 4],
             torque: [0.0; 4],
             first: st.members.len() as u32,
             count: members[k].len() as u32,
-            pad0: 0,
-            pad1: 0,
+            bonded: 0,
+            initial_count: members[k].len() as u32,
         });
         st.members.extend_from_slice(&members[k]);
     }
@@ -279,12 +284,53 @@ pub fn ejected_grains(m: &Model, st: &State) -> Option<(usize, usize)> {
         let crate::model::BodySource::Grain(g) = spec.source else {
             continue;
         };
+        if !st.bodies[k].moves() {
+            continue; // molten away or bonded into the substrate
+        }
         let height = st.bodies[k].x[up] as f64 + m.origin[up];
         if height > top + 2.0 * bed.grains[g].radius {
             ejected += 1;
         }
     }
     Some((ejected, bed.grains.len()))
+}
+
+/// What became of the rigid bodies (issue 17 item 6): bonded into the
+/// substrate, fully molten, partly molten, whole.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BodyTally {
+    pub bodies: usize,
+    pub bonded: usize,
+    pub molten: usize,
+    pub partly_molten: usize,
+    pub whole: usize,
+}
+
+impl BodyTally {
+    pub fn of(st: &State) -> BodyTally {
+        let mut t = BodyTally {
+            bodies: st.bodies.len(),
+            ..Default::default()
+        };
+        for b in &st.bodies {
+            if b.bonded != 0 {
+                t.bonded += 1;
+            } else if b.count == 0 {
+                t.molten += 1;
+            } else if b.count < b.initial_count {
+                t.partly_molten += 1;
+            } else {
+                t.whole += 1;
+            }
+        }
+        t
+    }
+    pub fn summary(&self) -> String {
+        format!(
+            "{} rigid: {} whole, {} partly molten, {} fully molten, {} bonded into the substrate",
+            self.bodies, self.whole, self.partly_molten, self.molten, self.bonded
+        )
+    }
 }
 
 /// A body's motion in world terms, f64, for outputs and checks.

@@ -21,7 +21,9 @@ const MAGIC: &[u8; 8] = b"SPATCKPT";
 // 2: a Dirichlet wall particle's fixed temperature is its heat.x (was 0; version 1
 // files would resume with 0 K walls).
 // 3: rigid bodies (body, body_offset, the body table and member list).
-const FORMAT_VERSION: u32 = 3;
+// 4: a body's particle inertia (inertia.w), bonded flag and initial member count
+// (melting bodies; version 3 bodies would recompute with zero particle inertia).
+const FORMAT_VERSION: u32 = 4;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
 const KEEP: usize = 2;

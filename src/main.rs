@@ -348,6 +348,10 @@ fn cmd_run(
             println!("{line}");
         }
     }
+    if !report.final_state.bodies.is_empty() {
+        let tally = spatter::bodies::BodyTally::of(&report.final_state);
+        println!("bodies: {}", tally.summary());
+    }
     if let Some((ejected, grains)) =
         spatter::bodies::ejected_grains(&loaded.model, &report.final_state)
     {

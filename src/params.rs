@@ -359,7 +359,9 @@ gpu_struct! {
         pub ln_c4: f32,
         pub four: f32,
         pub tenth: f32,
-        pub pad0: f32,
+        /// The rigid bodies' Jacobi rotations leave an off-diagonal entry at or
+        /// below this fraction of its diagonal pair (f32 rounding).
+        pub jacobi_floor: f32,
         pub pad1: f32,
         pub pad2: f32,
     }
@@ -418,7 +420,7 @@ pub const SHADER_CONSTS: Consts = {
         ln_c4: pm::LN_C[4],
         four: 4.0,
         tenth: 0.1,
-        pad0: 0.0,
+        jacobi_floor: 1e-7,
         pad1: 0.0,
         pad2: 0.0,
     }

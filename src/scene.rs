@@ -642,6 +642,8 @@ pub enum CheckKind {
     Flotation,
     /// Bodies at rest (a poured bed under gravity) stay at rest.
     BedAtRest,
+    /// A grain dropped into a melt melts completely, conserving mass and momentum.
+    MeltingGrain,
 }
 
 impl CheckKind {
@@ -669,6 +671,7 @@ impl CheckKind {
             CheckKind::FreeRotation => "free_rotation",
             CheckKind::Flotation => "flotation",
             CheckKind::BedAtRest => "bed_at_rest",
+            CheckKind::MeltingGrain => "melting_grain",
         }
     }
 }

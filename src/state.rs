@@ -82,6 +82,11 @@ pub struct State {
 /// `State::body` of a particle that belongs to no body.
 pub const NO_BODY: u32 = u32::MAX;
 
+/// `State::body` of a particle that solidified in this step, from the
+/// temperature pass until `bodies.melt` has bonded the bodies it touches (it is
+/// `NO_BODY` again after that pass).
+pub const BODY_SOLIDIFIED: u32 = u32::MAX - 1;
+
 /// One rigid body (F22 §2.2, §3.4): its state and mass properties in f32, the
 /// same bits on both backends (WGSL twin `Body` in shaders/lib/params.wgsl).
 /// Vectors are world-frame unless said; positions are grid-relative.
@@ -97,7 +102,8 @@ pub struct Body {
     pub v: [f32; 4],
     /// Angular momentum about the centre of mass (w 0).
     pub l: [f32; 4],
-    /// Principal moments of inertia (w 0).
+    /// Principal moments of inertia (xyz); w: the inertia per unit mass of one
+    /// particle about its own centre (for recomputing them when members melt).
     pub inertia: [f32; 4],
     /// Σ f over the members at the last force evaluation (contact and fluid;
     /// gravity is added in the kicks), world frame.
@@ -105,10 +111,28 @@ pub struct Body {
     /// Σ (x_r − x_k) × f_r, world frame.
     pub torque: [f32; 4],
     /// The body's members: `State::members[first..first + count]`.
+    /// Members that left (melted) are dropped from the range, so `count` is the
+    /// body's particles now.
     pub first: u32,
     pub count: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    /// 1 once the body is bonded into the substrate by melt that solidified next
+    /// to it: its members are fixed solid particles from then on (still listed,
+    /// `count` of them) and no body pass moves it.
+    pub bonded: u32,
+    /// Members at the start: the range `first..first + initial_count` is the
+    /// body's own in `State::members`.
+    pub initial_count: u32,
+}
+
+impl Body {
+    /// Still a free body: members left and not bonded (the body passes skip the rest).
+    pub fn moves(&self) -> bool {
+        self.count > 0 && self.bonded == 0
+    }
+    /// The fraction of its particles that melted away.
+    pub fn molten_fraction(&self) -> f64 {
+        1.0 - self.count as f64 / self.initial_count.max(1) as f64
+    }
 }
 
 /// A field viewed as raw 32-bit words, for bit-exact comparison.

@@ -15,6 +15,11 @@ fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) -> u32 {
 
 /// The same for a scene file anywhere; returns the CPU's final Sim.
 fn assert_bit_identical_at(path: &str, sets: &[&str], steps: u64) -> spatter::state::Sim {
+    bit_identical_state(path, sets, steps).sim
+}
+
+/// The same, returning the CPU's final state.
+fn bit_identical_state(path: &str, sets: &[&str], steps: u64) -> spatter::state::State {
     let name = path;
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let l = load(path, &sets).unwrap();
@@ -40,7 +45,7 @@ fn assert_bit_identical_at(path: &str, sets: &[&str], steps: u64) -> spatter::st
         report.stages_compared,
         (stages.prime.len() + stages.step.len() * steps as usize) as u64
     );
-    cpu.st.sim
+    cpu.st
 }
 
 #[test]
@@ -560,12 +565,171 @@ steps = 200
 }
 
 /// The same for a scene given as TOML text (written to a scratch file `name`).
-fn assert_bit_identical_text(name: &str, text: &str, steps: u64) {
+fn assert_bit_identical_text(name: &str, text: &str, steps: u64) -> spatter::state::State {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bitmatch_bodies");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    assert_bit_identical_at(path.to_str().unwrap(), &[], steps);
+    bit_identical_state(path.to_str().unwrap(), &[], steps)
+}
+
+/// Issue 17 item 4: a rigid grain melting in a pool (the melting-grain check's
+/// scene with the grain just below its solidus, so that 10 of its 52 particles
+/// leave in 200 steps): body_melt's departures (material velocity, own force),
+/// the recomputed mass, centre and principal axes (f32 Jacobi) and F22 (37).
+#[test]
+fn melting_grain_2d_200_steps() {
+    let st = bit_identical_state(
+        &common::scene("melting_grain_2d"),
+        &["phases.grain.temperature=1690.0"],
+        200,
+    );
+    let b = st.bodies[0];
+    assert!(b.count < b.initial_count && b.count > 0, "{b:?}");
+}
+
+/// Issue 17 item 4: melt that solidifies against rigid grains bonds them into
+/// the substrate (body_bond, then body_melt's bonding), 200 steps: a cold grain
+/// resting on a cold plate under a layer of melt at 1750 K; a second grain
+/// falls towards the melt.
+#[test]
+fn bonding_grains_2d_200_steps() {
+    let text = r#"
+[simulation]
+dimension = 2
+kernel = "quintic"
+dx = 5.0e-6
+gravity = [0.0, -9.81]
+pressure_floor = true
+
+[domain]
+min = [0.0, 0.0]
+max = [1.5e-4, 1.2e-4]
+wall_phase = "holder"
+open_sides = ["y_max"]
+
+[materials.steel]
+density = 7430.0
+viscosity = 6.0e-3
+sound_speed = 10.0
+conductivity = 35.95
+heat_capacity = 965.0
+solidus = 1695.0
+liquidus = 1705.0
+latent_heat = 2.7e5
+
+[phases.plate]
+kind = "solid"
+material = "steel"
+temperature = 1000.0
+melts_into = "melt"
+
+[phases.melt]
+kind = "liquid"
+material = "steel"
+temperature = 1750.0
+
+[phases.holder]
+kind = "wall"
+material = "steel"
+temperature = 1000.0
+
+[contact]
+stiffness = 1.0e4
+damping = 6.1e-2
+
+[[shapes]]
+phase = "plate"
+box = { min = [0.0, 0.0], max = [1.5e-4, 3.0e-5] }
+
+[[shapes]]
+phase = "melt"
+box = { min = [0.0, 3.0e-5], max = [1.5e-4, 6.0e-5] }
+
+[[shapes]]
+phase = "plate"
+body = true
+sphere = { center = [4.0e-5, 4.6e-5], radius = 1.5e-5 }
+
+[[shapes]]
+phase = "plate"
+body = true
+sphere = { center = [1.1e-4, 9.0e-5], radius = 1.0e-5 }
+velocity = [0.0, -0.3]
+
+[run]
+steps = 200
+"#;
+    let st = assert_bit_identical_text("bonding_2d", text, 200);
+    assert_eq!(st.bodies[0].bonded, 1, "the grain in the melt bonded");
+    assert_eq!(st.bodies[1].bonded, 0, "the falling grain is still free");
+}
+
+/// Issue 17 item 4 in 3D: a grain just below its solidus in a pool of melt at
+/// 2500 K, weightless, 200 steps: departures and the full 3D Jacobi (every
+/// off-diagonal entry is non-zero once members leave unevenly).
+#[test]
+fn melting_grain_3d_200_steps() {
+    let text = r#"
+[simulation]
+dimension = 3
+kernel = "wendland_c2"
+dx = 5.0e-6
+gravity = [0.0, 0.0, 0.0]
+pressure_floor = true
+
+[domain]
+min = [0.0, 0.0, 0.0]
+max = [1.2e-4, 8.0e-5, 8.0e-5]
+wall_phase = "wall"
+open_sides = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"]
+
+[materials.steel]
+density = 7430.0
+viscosity = 6.0e-3
+sound_speed = 10.0
+conductivity = 35.95
+heat_capacity = 965.0
+solidus = 1695.0
+liquidus = 1705.0
+latent_heat = 2.7e5
+
+[phases.grain]
+kind = "solid"
+material = "steel"
+temperature = 1690.0
+melts_into = "melt"
+
+[phases.melt]
+kind = "liquid"
+material = "steel"
+temperature = 2500.0
+
+[phases.wall]
+kind = "wall"
+material = "steel"
+
+[contact]
+stiffness = 1000.0
+damping = 0.0
+
+[[shapes]]
+phase = "melt"
+sphere = { center = [7.0e-5, 4.0e-5, 4.0e-5], radius = 2.5e-5 }
+
+[[shapes]]
+phase = "grain"
+body = true
+velocity = [0.5, 0.1, 0.0]
+angular_velocity = [0.0, 2.0e4, 1.0e4]
+sphere = { center = [3.4e-5, 4.2e-5, 3.9e-5], radius = 1.2e-5 }
+
+[run]
+steps = 200
+"#;
+    let st = assert_bit_identical_text("melting_grain_3d", text, 200);
+    let b = st.bodies[0];
+    assert!(b.count < b.initial_count, "{b:?}");
 }
 
 /// Issue 17: a bed of 1000 rigid grains (the bed-at-rest scene widened to

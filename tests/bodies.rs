@@ -141,15 +141,12 @@ fn bad_body_input_exits_2_naming_the_key() {
         "domain.periodic",
     );
     assert_input_error(&["validate", &s, "--set", "run.dt=0.01"], "run.dt");
-    // Rigid grains of a phase that melts (the coarse PBF bed's plate).
+    // Rigid grains of a phase that melts are bodies like any other: [contact].
     let pbf = format!(
         "{}/scenarios/pbf/powder_bed_line_melt_coarse_2d.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    assert_input_error(
-        &["validate", &pbf, "--set", "powder.rigid=true"],
-        "powder.rigid",
-    );
+    assert_input_error(&["validate", &pbf, "--set", "powder.rigid=true"], "contact");
     assert_input_error(
         &["validate", &s, "--set", "contact.stiffness=-1.0"],
         "contact.stiffness",
@@ -236,4 +233,123 @@ fn ejected_grains_are_counted() {
         rest.starts_with("powder: of 180 rigid grains 0 ejected"),
         "{rest}"
     );
+}
+
+/// Issue 17 item 4, the melting-grain check: a grain thrown into a melt at
+/// 2500 K melts completely (52 particles leave one by one, F22 (37)); the melt
+/// gains the grain's mass and the momentum of melt plus grain stays within 1e-5
+/// of its start (measured 5.4e-7).
+#[test]
+fn melting_grain_melts_conserving_mass_and_momentum() {
+    let out = run_passes("melting_grain_2d", &[]);
+    assert!(
+        out.contains("bodies: 1 rigid: 0 whole, 0 partly molten, 1 fully molten, 0 bonded"),
+        "{out}"
+    );
+    assert!(
+        out.contains("52 body particles at the start, 0 left"),
+        "{out}"
+    );
+}
+
+/// Issue 17 item 4, the bonding rule: melt that solidifies within 1.5 Δx of a
+/// rigid grain bonds it into the substrate. A cold grain (1000 K) rests on a
+/// cold plate under a layer of melt at 1750 K: the melt freezes against both and
+/// the grain is bonded; from then on its particles are fixed solid (velocity 0,
+/// no body), and they stay where they were while the run goes on.
+#[test]
+fn solidifying_melt_bonds_a_grain_to_the_substrate() {
+    use spatter::backend::{cpu::CpuBackend, Backend};
+    let dir = scratch("bodies_bond");
+    let path = dir.join("bond.toml");
+    std::fs::write(
+        &path,
+        r#"
+[simulation]
+dimension = 2
+kernel = "quintic"
+dx = 5.0e-6
+gravity = [0.0, -9.81]
+pressure_floor = true
+
+[domain]
+min = [0.0, 0.0]
+max = [1.5e-4, 1.2e-4]
+wall_phase = "holder"
+open_sides = ["y_max"]
+
+[materials.steel]
+density = 7430.0
+viscosity = 6.0e-3
+sound_speed = 10.0
+conductivity = 35.95
+heat_capacity = 965.0
+solidus = 1695.0
+liquidus = 1705.0
+latent_heat = 2.7e5
+
+[phases.plate]
+kind = "solid"
+material = "steel"
+temperature = 1000.0
+melts_into = "melt"
+
+[phases.melt]
+kind = "liquid"
+material = "steel"
+temperature = 1750.0
+
+[phases.holder]
+kind = "wall"
+material = "steel"
+temperature = 1000.0
+
+[contact]
+stiffness = 1.0e4
+damping = 6.1e-2
+
+[[shapes]]
+phase = "plate"
+box = { min = [0.0, 0.0], max = [1.5e-4, 3.0e-5] }
+
+[[shapes]]
+phase = "melt"
+box = { min = [0.0, 3.0e-5], max = [1.5e-4, 6.0e-5] }
+
+[[shapes]]
+phase = "plate"
+body = true
+sphere = { center = [4.0e-5, 4.6e-5], radius = 1.5e-5 }
+
+[run]
+steps = 300
+"#,
+    )
+    .unwrap();
+    let l = spatter::run::load(path.to_str().unwrap(), &[]).unwrap();
+    let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
+    let mut cpu = CpuBackend::new(params, l.state.clone());
+    cpu.prime();
+    cpu.run_steps(150);
+    let b = cpu.st.bodies[0];
+    assert_eq!(b.bonded, 1, "{b:?}");
+    assert!(b.count > 0 && b.count == b.initial_count, "{b:?}");
+    let members: Vec<u32> = cpu.st.members[b.first as usize..(b.first + b.count) as usize].to_vec();
+    let at = |st: &spatter::state::State| -> Vec<[f32; 4]> {
+        let mut slot = vec![0usize; st.len()];
+        for i in 0..st.active() {
+            slot[st.id[i] as usize] = i;
+        }
+        members
+            .iter()
+            .map(|&id| st.pos[slot[id as usize]])
+            .collect()
+    };
+    let before = at(&cpu.st);
+    cpu.run_steps(150);
+    assert_eq!(before, at(&cpu.st), "bonded particles stay put");
+    for &id in &members {
+        assert_eq!(cpu.st.body[id as usize], spatter::state::NO_BODY);
+    }
+    assert_eq!(cpu.st.bodies[0], b, "a bonded body is left alone");
 }

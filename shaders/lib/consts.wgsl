@@ -18,3 +18,4 @@ fn c_three_quarters() -> f32 { return P.consts.three_quarters; }
 fn c_nine_quarters() -> f32 { return P.consts.nine_quarters; }
 fn c_four() -> f32 { return P.consts.four; }
 fn c_tenth() -> f32 { return P.consts.tenth; }
+fn c_jacobi_floor() -> f32 { return P.consts.jacobi_floor; }

@@ -179,7 +179,7 @@ struct Consts {
     ln_c4: f32,
     four: f32,
     tenth: f32,
-    pad0: f32,
+    jacobi_floor: f32,
     pad1: f32,
     pad2: f32,
 }
@@ -215,13 +215,13 @@ struct Body {
     q: vec4<f32>,            // orientation quaternion (x, y, z, w), body -> world
     v: vec4<f32>,            // velocity of the centre of mass
     l: vec4<f32>,            // angular momentum about the centre of mass
-    inertia: vec4<f32>,      // principal moments
+    inertia: vec4<f32>,      // principal moments; w: one particle's own, per unit mass
     force: vec4<f32>,        // sum of member forces (contact, fluid)
     torque: vec4<f32>,       // sum of (x_r - x_k) x f_r
-    first: u32,              // members[first .. first + count]
+    first: u32,              // members[first .. first + count] (melted ones dropped)
     count: u32,
-    pad0: u32,
-    pad1: u32,
+    bonded: u32,             // 1: bonded into the substrate (count 0)
+    initial_count: u32,      // members at the start
 }
 
 const FLAG_PRESSURE_FLOOR: u32 = 8u;
@@ -235,6 +235,8 @@ const FLAG_FREE_SURFACE_TENSION: u32 = 1024u;
 const FLAG_WETTING: u32 = 2048u;
 const FLAG_BODIES: u32 = 4096u;
 const NO_BODY: u32 = 4294967295u;
+// body[id] of a particle that solidified in this step, until body_bond.
+const BODY_SOLIDIFIED: u32 = 4294967294u;
 const NO_PHASE: u32 = 4294967295u;
 const KIND_LIQUID: u32 = 0u;
 const KIND_GAS: u32 = 1u;

@@ -42,3 +42,8 @@ fn body_point_velocity(b: Body, x: vec4<f32>) -> vec3<f32> {
         b.v.y + w.z * r.x - w.x * r.z,
         b.v.z + w.x * r.y - w.y * r.x);
 }
+
+// Still a free body: members left and not bonded (the body passes skip the rest).
+fn body_moves(b: Body) -> bool {
+    return b.count > 0u && b.bonded == 0u;
+}

@@ -45,12 +45,15 @@ pub enum Stage {
     BodyForces,
     /// Rigid bodies: second half kick.
     BodyKick,
+    /// Melting rigid bodies: melted members leave (F22 (37)), bodies touched by
+    /// solidifying melt bond into the substrate.
+    BodyMelt,
 }
 
 /// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
 /// previous step, then the temperatures following the new enthalpies.
-pub const STEP: [Stage; 15] = [
+pub const STEP: [Stage; 16] = [
     Stage::KickDrift,     // v += Δt/2 a, x += Δt ṽ (transport velocity)
     Stage::BodyDrift,     // bodies: V, L += Δt/2 (F, τ); X += Δt V; rotate; place
     Stage::Neighbors,     // sort by cell, cell table
@@ -63,6 +66,7 @@ pub const STEP: [Stage; 15] = [
     Stage::Laser,         // absorbed laser power
     Stage::Heat,          // conduction and surface losses, enthalpy update
     Stage::Temperature,   // T and f_l from h; melting and solidification
+    Stage::BodyMelt,      // bodies: melted members leave, solidified melt bonds
     Stage::Kick,          // v += Δt/2 a
     Stage::BodyKick,      // bodies: V, L += Δt/2 (F, τ)
     Stage::Timestep,      // Δt for the next step
@@ -70,7 +74,7 @@ pub const STEP: [Stage; 15] = [
 
 /// Run once before the first step: accelerations, temperatures and Δt of the
 /// initial state.
-pub const PRIME: [Stage; 9] = [
+pub const PRIME: [Stage; 10] = [
     Stage::Neighbors,
     Stage::Density,
     Stage::Wall,
@@ -79,6 +83,7 @@ pub const PRIME: [Stage; 9] = [
     Stage::SurfaceForces,
     Stage::BodyForces,
     Stage::Temperature,
+    Stage::BodyMelt,
     Stage::Timestep,
 ];
 
@@ -183,7 +188,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 15] = [
+pub const STAGES: [StageDef; 16] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -379,6 +384,17 @@ pub const STAGES: [StageDef; 15] = [
         gpu: &[always("body_kick", Work::Bodies)],
         cpu: |b| b.body_kick(),
     },
+    StageDef {
+        stage: Stage::BodyMelt,
+        name: "bodies.melt",
+        file: "bodies",
+        needed: |f| f.bodies && f.heat,
+        gpu: &[
+            always("body_bond", Work::Particles),
+            always("body_melt", Work::Bodies),
+        ],
+        cpu: |b| b.body_melt(),
+    },
 ];
 
 impl Stage {
@@ -418,6 +434,6 @@ mod tests {
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 32);
+        assert_eq!(e.len(), 34);
     }
 }

@@ -58,6 +58,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=2e-5"],
     ),
     (scene_file!("validation/melt_block_3d"), &["dx=1e-5"]),
+    (scene_file!("validation/melting_grain_2d"), &[]),
     (
         scene_file!("validation/poiseuille_2d"),
         &["dx=6.666666666666667e-5"],

@@ -5,6 +5,7 @@
 use super::Verdict;
 use crate::bodies::BodyMotion;
 use crate::model::Model;
+use crate::scene::PhaseKind;
 use crate::state::State;
 
 /// Coefficient of restitution of F22 (39)–(40) for two bodies of effective mass
@@ -324,6 +325,131 @@ impl super::Check for AtRest {
             value: moved,
             details,
             figures: vec![("settling_dx".into(), self.settling / m.dx)],
+        }
+    }
+}
+
+/// A grain dropped into a melt above its melting temperature (F22 (37)): it
+/// melts completely, the melt gains exactly the grain's mass, and the momentum
+/// of melt plus bodies, Σ m v over fluid particles + Σ M V over bodies, stays
+/// at its initial value. The metric is the largest |P − P0| / |P0| over the
+/// samples; not fully molten, or a mass that does not balance: infinite.
+#[derive(Default)]
+pub struct MeltingGrain {
+    /// P0 and the fluid and body masses at the first sample.
+    start: Option<([f64; 3], f64, f64)>,
+    largest: f64,
+    /// The largest Σ m |v| seen (what f32 rounding is relative to).
+    agitation: f64,
+}
+
+/// (momentum of fluid particles and bodies, fluid mass, body mass), f64 sums.
+fn melt_and_bodies(m: &Model, st: &State) -> ([f64; 3], f64, f64) {
+    let mut p = [0.0; 3];
+    let mut fluid = 0.0;
+    for i in 0..st.active() {
+        if matches!(
+            m.phases[st.phase[i] as usize].kind,
+            PhaseKind::Wall | PhaseKind::Solid
+        ) {
+            continue;
+        }
+        let mi = st.mass[i] as f64;
+        fluid += mi;
+        for (c, pc) in p.iter_mut().enumerate() {
+            *pc += mi * st.vel[i][c] as f64;
+        }
+    }
+    let mut body = 0.0;
+    for b in st.bodies.iter().filter(|b| b.moves()) {
+        let mb = b.x[3] as f64;
+        body += mb;
+        for (c, pc) in p.iter_mut().enumerate() {
+            *pc += mb * b.v[c] as f64;
+        }
+    }
+    (p, fluid, body)
+}
+
+impl super::Check for MeltingGrain {
+    fn observe(&mut self, m: &Model, st: &State) {
+        let (p, fluid, body) = melt_and_bodies(m, st);
+        let agitation: f64 = (0..st.active())
+            .filter(|&i| {
+                !matches!(
+                    m.phases[st.phase[i] as usize].kind,
+                    PhaseKind::Wall | PhaseKind::Solid
+                )
+            })
+            .map(|i| {
+                st.mass[i] as f64
+                    * (0..3)
+                        .map(|c| (st.vel[i][c] as f64).powi(2))
+                        .sum::<f64>()
+                        .sqrt()
+            })
+            .sum::<f64>()
+            + st.bodies
+                .iter()
+                .filter(|b| b.moves())
+                .map(|b| {
+                    b.x[3] as f64 * (0..3).map(|c| (b.v[c] as f64).powi(2)).sum::<f64>().sqrt()
+                })
+                .sum::<f64>();
+        self.agitation = self.agitation.max(agitation);
+        let Some((p0, _, _)) = self.start else {
+            self.start = Some((p, fluid, body));
+            return;
+        };
+        let norm = p0.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let dev = (0..3).map(|c| (p[c] - p0[c]).powi(2)).sum::<f64>().sqrt();
+        self.largest = self.largest.max(dev / norm);
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let metric = "largest |P - P0| / |P0| (melt + bodies)".to_string();
+        let (p0, fluid0, body0) = self.start.unwrap_or_default();
+        let (p, fluid, _) = melt_and_bodies(m, st);
+        let left = st.bodies.iter().map(|b| b.count as u64).sum::<u64>();
+        let initial = st
+            .bodies
+            .iter()
+            .map(|b| b.initial_count as u64)
+            .sum::<u64>();
+        let bonded = st.bodies.iter().filter(|b| b.bonded != 0).count();
+        // Each particle keeps its mass, so the melt's gain is the sum of the
+        // grain particles' masses: equal to the body mass at the start up to the
+        // f32 rounding of that sum (relative 1e-6 for a few hundred members).
+        let gained = fluid - fluid0;
+        let mass_error = (gained - body0).abs() / body0;
+        let molten = left == 0 && bonded == 0;
+        let details = vec![
+            format!(
+                "melting grain: {initial} body particles at the start, {left} left in bodies, {bonded} bodies bonded (t = {:.4e} s, step {})",
+                st.sim.time, st.sim.step
+            ),
+            format!(
+                "mass: the melt gained {gained:.6e} kg (per unit depth in 2D), the bodies held {body0:.6e} at the start: relative {mass_error:.2e}"
+            ),
+            format!(
+                "momentum: P0 = ({:.6e}, {:.6e}, {:.6e}), end ({:.6e}, {:.6e}, {:.6e}); largest relative change {:.3e}; largest sum of m |v| {:.3e} ({:.2}|P0|)",
+                p0[0], p0[1], p0[2], p[0], p[1], p[2], self.largest, self.agitation,
+                self.agitation / p0.iter().map(|c| c * c).sum::<f64>().sqrt()
+            ),
+        ];
+        let value = if molten && mass_error < 1e-6 {
+            self.largest
+        } else {
+            f64::INFINITY
+        };
+        Verdict {
+            metric,
+            value,
+            details,
+            figures: vec![
+                ("particles_left".into(), left as f64),
+                ("mass_error".into(), mass_error),
+            ],
         }
     }
 }

@@ -7,7 +7,7 @@
 //! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy),
 //! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
-//! bodies: restitution, free rotation).
+//! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain).
 
 mod bodies;
 mod compression;
@@ -144,6 +144,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Restitution => Box::new(bodies::Restitution),
         CheckKind::Flotation => Box::new(bodies::Flotation),
         CheckKind::BedAtRest => Box::new(bodies::AtRest::new(c.settle_time)),
+        CheckKind::MeltingGrain => Box::new(bodies::MeltingGrain::default()),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

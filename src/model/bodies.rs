@@ -33,7 +33,7 @@ pub enum BodySource {
 }
 
 /// The body shapes and `[contact]`, validated. Bodies are made of a wall or solid
-/// phase that does not melt (melting bodies are not built yet), need `[contact]`
+/// phase, need `[contact]`
 /// (without it they would pass through the walls and each other) and a domain
 /// without periodic axes (a body is not wrapped).
 pub(super) fn bodies(
@@ -114,20 +114,14 @@ pub(super) fn bodies(
     Ok((specs, contact))
 }
 
-/// A body's phase: a wall or solid that does not melt and has no prescribed
-/// motion.
+/// A body's phase: a wall or solid (one that melts too: its melted particles
+/// leave the body, `bodies.melt`) with no prescribed motion.
 fn body_phase(cx: &Ctx, key: &str, ph: &PhaseInfo) -> Result<(), InputError> {
     let name = &ph.name;
     if !matches!(ph.kind, PhaseKind::Wall | PhaseKind::Solid) {
         return Err(cx.err(
             key,
             format!("a rigid body is made of a wall or solid phase; `{name}` flows"),
-        ));
-    }
-    if ph.switch_to.is_some() {
-        return Err(cx.err(
-            key,
-            format!("phase `{name}` melts: melting rigid bodies are not supported yet"),
         ));
     }
     if ph.moves {

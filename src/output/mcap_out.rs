@@ -244,6 +244,8 @@ fn bodies_message(m: &Model, st: &State) -> serde_json::Value {
                 "angular_velocity": mo.angular_velocity,
                 "mass": mo.mass,
                 "particles": b.count,
+                "molten_fraction": b.molten_fraction(),
+                "bonded": b.bonded != 0,
             })
         })
         .collect();
@@ -269,9 +271,11 @@ fn bodies_schema() -> serde_json::Value {
                     "velocity": vec(3, "of the centre of mass (m/s)"),
                     "angular_velocity": vec(3, "world frame (rad/s)"),
                     "mass": {"type": "number", "description": "kg (kg per metre of depth in 2D)"},
-                    "particles": {"type": "integer", "description": "member particles"}
+                    "particles": {"type": "integer", "description": "member particles (melted ones have left)"},
+                    "molten_fraction": {"type": "number", "description": "fraction of the body's initial particles that melted away"},
+                    "bonded": {"type": "boolean", "description": "bonded into the substrate by melt that solidified against it (then fixed)"}
                 },
-                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles"]
+                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles", "molten_fraction", "bonded"]
             }}
         },
         "required": ["time", "bodies"]

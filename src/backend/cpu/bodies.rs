@@ -29,8 +29,8 @@
 use super::neighbors::{for_each_neighbor, CellTable};
 use super::terms;
 use crate::kernel;
-use crate::params::{Params, PHASE_FREE_SLIP};
-use crate::state::{Body, State, NO_BODY};
+use crate::params::{Params, PHASE_FREE_SLIP, SHADER_CONSTS};
+use crate::state::{Body, State, BODY_SOLIDIFIED, NO_BODY};
 use rayon::prelude::*;
 
 pub type V3 = [f32; 3];
@@ -139,6 +139,9 @@ pub fn drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
     let g = pr.flow.gravity;
     st.bodies.par_iter_mut().for_each(|b| {
+        if !b.moves() {
+            return;
+        }
         kick_body(b, 0.5 * dt, g);
         for c in 0..3 {
             b.x[c] += dt * b.v[c];
@@ -244,6 +247,9 @@ pub fn sum(st: &mut State) {
     }
     let (pos, acc, members) = (&st.pos, &st.acc, &st.members);
     st.bodies.par_iter_mut().for_each(|b| {
+        if !b.moves() {
+            return;
+        }
         let mut f = [0.0f32; 3];
         let mut t = [0.0f32; 3];
         for &id in &members[b.first as usize..(b.first + b.count) as usize] {
@@ -268,5 +274,340 @@ pub fn kick(pr: &Params, st: &mut State) {
     let g = pr.flow.gravity;
     st.bodies
         .par_iter_mut()
+        .filter(|b| b.moves())
         .for_each(|b| kick_body(b, 0.5 * dt, g));
+}
+
+/// Particles that solidified this step bond the bodies they touch: within this
+/// reach (in Δx) of a body particle, which covers a lattice's diagonal neighbour.
+pub const BOND_REACH: f32 = 1.5;
+
+/// `body_bond`: a particle that solidified in this step (`BODY_SOLIDIFIED`, set
+/// by the temperature pass) flags every body particle within `BOND_REACH` Δx
+/// (body_offset.w = 1) and is `NO_BODY` again.
+pub fn bond(pr: &Params, st: &mut State, grid: &CellTable) {
+    let n = st.active();
+    let reach = BOND_REACH * pr.bodies.contact_distance;
+    let reach2 = reach * reach;
+    let n_bodies = pr.bodies.n_bodies;
+    let mut touched = Vec::new();
+    for i in 0..n {
+        if st.body[st.id[i] as usize] != BODY_SOLIDIFIED {
+            continue;
+        }
+        st.body[st.id[i] as usize] = NO_BODY;
+        let (body, id) = (&st.body, &st.id);
+        for_each_neighbor(pr, &st.pos, grid, i, |j, _d, r2| {
+            if r2 < reach2 && body[id[j] as usize] < n_bodies {
+                touched.push(id[j] as usize);
+            }
+        });
+    }
+    for id in touched {
+        st.body_offset[id][3] = 1.0;
+    }
+}
+
+/// `body_melt`, F22 (37) and the bonding rule, per body with a member that
+/// melted or was touched by solidifying melt (the rest are left as they are):
+/// - touched (`body_offset.w` set): the body is bonded into the substrate: its
+///   solid members become fixed solid particles (at rest), count 0;
+/// - otherwise the melted members leave: each keeps its material velocity
+///   V + ω × r as a fluid particle; the rest are the new body, with its mass,
+///   centre and principal axes recomputed from their body-frame offsets, ω
+///   unchanged and V the velocity the old motion gave the new centre, so the
+///   linear momentum of body plus melt is unchanged (angular momentum up to the
+///   departing particle's own spin m I_r ω, which SPH does not carry).
+pub fn melt(pr: &Params, st: &mut State) {
+    let n = st.active();
+    let mut slot = vec![0u32; st.len()];
+    for i in 0..n {
+        slot[st.id[i] as usize] = i as u32;
+    }
+    for k in 0..st.bodies.len() {
+        let b = st.bodies[k];
+        if !b.moves() {
+            continue;
+        }
+        let range = b.first as usize..(b.first + b.count) as usize;
+        let mut melted = false;
+        let mut touched = false;
+        for &id in &st.members[range.clone()] {
+            melted |= !pr.is_wall(st.phase[slot[id as usize] as usize]);
+            touched |= st.body_offset[id as usize][3] > 0.0;
+        }
+        if touched {
+            bond_body(pr, st, k, &slot);
+        } else if melted {
+            shed(pr, st, k, &slot);
+        }
+    }
+}
+
+/// A melted member leaves body b: a fluid particle with b's material velocity,
+/// taking its own force f of this step (in acc since `bodies.forces`) with it as
+/// its acceleration f/m for the second half kick; returns f, which the body
+/// no longer gets (with the last member gone it would be lost otherwise).
+fn release(st: &mut State, b: &Body, id: u32, i: usize) -> V3 {
+    let u = point_velocity(b, &st.pos[i]);
+    let f = [st.acc[i][0], st.acc[i][1], st.acc[i][2]];
+    let m = st.mass[i];
+    st.vel[i] = [u[0], u[1], u[2], st.vel[i][3]];
+    st.acc[i] = [f[0] / m, f[1] / m, f[2] / m, 0.0];
+    st.acc_b[i] = [0.0; 4];
+    st.body[id as usize] = NO_BODY;
+    f
+}
+
+/// Body k bonds into the substrate: melted members leave, the rest stay put as
+/// fixed solid particles and stay listed (`count`, the mass they make), so the
+/// body's molten fraction stays readable; `bonded` stops every body pass.
+fn bond_body(pr: &Params, st: &mut State, k: usize, slot: &[u32]) {
+    let b = st.bodies[k];
+    let mut kept = 0u32;
+    let mut m_new = 0.0f32;
+    for m in b.first..b.first + b.count {
+        let id = st.members[m as usize];
+        let i = slot[id as usize] as usize;
+        st.body[id as usize] = NO_BODY;
+        if !pr.is_wall(st.phase[i]) {
+            // Its force leaves with it; the rest goes into the substrate.
+            release(st, &b, id, i);
+            continue;
+        }
+        st.members[(b.first + kept) as usize] = id;
+        kept += 1;
+        m_new += st.mass[i];
+        st.vel[i] = [0.0, 0.0, 0.0, st.vel[i][3]];
+        st.acc[i] = [0.0; 4];
+        st.acc_b[i] = [0.0; 4];
+    }
+    let b = &mut st.bodies[k];
+    b.count = kept;
+    b.x[3] = m_new;
+    b.bonded = 1;
+    b.v = [0.0; 4];
+    b.l = [0.0; 4];
+    b.force = [0.0; 4];
+    b.torque = [0.0; 4];
+}
+
+/// Body k sheds its melted members (F22 (37)); see `melt`.
+fn shed(pr: &Params, st: &mut State, k: usize, slot: &[u32]) {
+    let b = st.bodies[k];
+    // Melted members leave; the rest are compacted in place, in id order.
+    let mut kept = 0u32;
+    let mut m_new = 0.0f32;
+    let mut s = [0.0f32; 3];
+    // The force and torque (about the old centre) of the members that stay.
+    let (mut f, mut t) = (
+        [b.force[0], b.force[1], b.force[2]],
+        [b.torque[0], b.torque[1], b.torque[2]],
+    );
+    for m in b.first..b.first + b.count {
+        let id = st.members[m as usize];
+        let i = slot[id as usize] as usize;
+        if !pr.is_wall(st.phase[i]) {
+            let x = st.pos[i];
+            let fk = release(st, &b, id, i);
+            let r = [x[0] - b.x[0], x[1] - b.x[1], x[2] - b.x[2]];
+            f = [f[0] - fk[0], f[1] - fk[1], f[2] - fk[2]];
+            t = [
+                t[0] - r[1] * fk[2] + r[2] * fk[1],
+                t[1] - r[2] * fk[0] + r[0] * fk[2],
+                t[2] - r[0] * fk[1] + r[1] * fk[0],
+            ];
+            continue;
+        }
+        st.members[(b.first + kept) as usize] = id;
+        kept += 1;
+        let (mi, r0) = (st.mass[i], st.body_offset[id as usize]);
+        m_new += mi;
+        for c in 0..3 {
+            s[c] += mi * r0[c];
+        }
+    }
+    let mut nb = b;
+    nb.count = kept;
+    if kept == 0 {
+        nb.x[3] = 0.0;
+        nb.v = [0.0; 4];
+        nb.l = [0.0; 4];
+        nb.force = [0.0; 4];
+        nb.torque = [0.0; 4];
+        st.bodies[k] = nb;
+        return;
+    }
+    // The new centre in the body frame, and the inertia tensor about it.
+    let c0 = [s[0] / m_new, s[1] / m_new, s[2] / m_new];
+    let ip = b.inertia[3];
+    let mut a = [[0.0f32; 3]; 3];
+    for m in b.first..b.first + kept {
+        let id = st.members[m as usize];
+        let mi = st.mass[slot[id as usize] as usize];
+        let o = st.body_offset[id as usize];
+        let r = [o[0] - c0[0], o[1] - c0[1], o[2] - c0[2]];
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        for p in 0..3 {
+            a[p][p] += mi * (ip + r2 - r[p] * r[p]);
+        }
+        a[0][1] -= mi * (r[0] * r[1]);
+        a[0][2] -= mi * (r[0] * r[2]);
+        a[1][2] -= mi * (r[1] * r[2]);
+    }
+    a[1][0] = a[0][1];
+    a[2][0] = a[0][2];
+    a[2][1] = a[1][2];
+    let (moments, axes) = jacobi(a);
+    // New body frame: old frame turned by the principal axes; offsets Qᵀ (r0 − c0).
+    for m in b.first..b.first + kept {
+        let id = st.members[m as usize] as usize;
+        let o = st.body_offset[id];
+        let r = [o[0] - c0[0], o[1] - c0[1], o[2] - c0[2]];
+        let t = transpose_times(&axes, r);
+        st.body_offset[id] = [t[0], t[1], t[2], 0.0];
+    }
+    let w = angular_velocity(&b);
+    let cw = rotate(b.q, c0);
+    let q = normalized(quat_mul(b.q, quaternion_of(&axes)));
+    let lb = rotate(conj(q), w);
+    let l = rotate(
+        q,
+        [lb[0] * moments[0], lb[1] * moments[1], lb[2] * moments[2]],
+    );
+    nb.x = [b.x[0] + cw[0], b.x[1] + cw[1], b.x[2] + cw[2], m_new];
+    nb.q = q;
+    nb.v = [
+        b.v[0] + w[1] * cw[2] - w[2] * cw[1],
+        b.v[1] + w[2] * cw[0] - w[0] * cw[2],
+        b.v[2] + w[0] * cw[1] - w[1] * cw[0],
+        0.0,
+    ];
+    nb.l = [l[0], l[1], l[2], 0.0];
+    nb.inertia = [moments[0], moments[1], moments[2], ip];
+    // The torque about the new centre: τ − c × F.
+    nb.force = [f[0], f[1], f[2], 0.0];
+    nb.torque = [
+        t[0] - cw[1] * f[2] + cw[2] * f[1],
+        t[1] - cw[2] * f[0] + cw[0] * f[2],
+        t[2] - cw[0] * f[1] + cw[1] * f[0],
+        0.0,
+    ];
+    st.bodies[k] = nb;
+}
+
+#[inline(always)]
+fn normalized(q: [f32; 4]) -> [f32; 4] {
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
+}
+
+type M3 = [[f32; 3]; 3];
+
+/// a b, each entry one left-to-right chain.
+fn mat_mul(a: &M3, b: &M3) -> M3 {
+    let mut c = [[0.0f32; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+        }
+    }
+    c
+}
+
+fn transpose(a: &M3) -> M3 {
+    let mut t = [[0.0f32; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            t[i][j] = a[j][i];
+        }
+    }
+    t
+}
+
+/// Qᵀ r.
+fn transpose_times(q: &M3, r: V3) -> V3 {
+    [0, 1, 2].map(|j| q[0][j] * r[0] + q[1][j] * r[1] + q[2][j] * r[2])
+}
+
+/// Sweeps of `jacobi`: each squares the off-diagonal's relative size, so 6 take
+/// any f32 tensor to its rounding.
+const JACOBI_SWEEPS: u32 = 6;
+
+/// Eigen-decomposition of a symmetric 3×3 tensor in f32 by cyclic Jacobi
+/// rotations with the algebraic angle (tan φ from cot 2φ, square roots only: no
+/// trigonometry on the bit-matched path): (moments, Q) with the axes as Q's
+/// columns, Q a proper rotation. An entry at or below 1e-7 of its diagonal pair
+/// is f32 rounding and is left; an exact zero (a planar body's xz, yz) is never
+/// rotated, so z stays a principal axis.
+pub fn jacobi(a: M3) -> (V3, M3) {
+    let mut a = a;
+    let mut q: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..JACOBI_SWEEPS {
+        for (p, r) in [(0usize, 1usize), (0, 2), (1, 2)] {
+            let apr = a[p][r];
+            if apr.abs() <= SHADER_CONSTS.jacobi_floor * (a[p][p].abs() + a[r][r].abs()) {
+                continue;
+            }
+            let theta = (a[r][r] - a[p][p]) / (apr + apr);
+            let t_abs = 1.0 / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta < 0.0 { -t_abs } else { t_abs };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            let mut g: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            g[p][p] = c;
+            g[r][r] = c;
+            g[p][r] = s;
+            g[r][p] = -s;
+            a = mat_mul(&transpose(&g), &mat_mul(&a, &g));
+            a[p][r] = 0.0;
+            a[r][p] = 0.0;
+            q = mat_mul(&q, &g);
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], q)
+}
+
+/// The unit quaternion of a rotation matrix (Shepperd: the largest of the four
+/// squared components first), f32 twin of `crate::bodies::quaternion_of`.
+pub fn quaternion_of(r: &M3) -> [f32; 4] {
+    let t = r[0][0] + r[1][1] + r[2][2];
+    let q = if t > r[0][0].max(r[1][1]).max(r[2][2]) {
+        let w = 0.5 * (1.0 + t).sqrt();
+        let f = 0.25 / w;
+        [
+            (r[2][1] - r[1][2]) * f,
+            (r[0][2] - r[2][0]) * f,
+            (r[1][0] - r[0][1]) * f,
+            w,
+        ]
+    } else if r[0][0] >= r[1][1] && r[0][0] >= r[2][2] {
+        let x = 0.5 * (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt();
+        let f = 0.25 / x;
+        [
+            x,
+            (r[0][1] + r[1][0]) * f,
+            (r[0][2] + r[2][0]) * f,
+            (r[2][1] - r[1][2]) * f,
+        ]
+    } else if r[1][1] >= r[2][2] {
+        let y = 0.5 * (1.0 - r[0][0] + r[1][1] - r[2][2]).sqrt();
+        let f = 0.25 / y;
+        [
+            (r[0][1] + r[1][0]) * f,
+            y,
+            (r[1][2] + r[2][1]) * f,
+            (r[0][2] - r[2][0]) * f,
+        ]
+    } else {
+        let z = 0.5 * (1.0 - r[0][0] - r[1][1] + r[2][2]).sqrt();
+        let f = 0.25 / z;
+        [
+            (r[0][2] + r[2][0]) * f,
+            (r[1][2] + r[2][1]) * f,
+            z,
+            (r[1][0] - r[0][1]) * f,
+        ]
+    };
+    normalized(q)
 }

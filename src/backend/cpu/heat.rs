@@ -23,9 +23,11 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID};
+use crate::params::{
+    Params, FLAG_BODIES, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID,
+};
 use crate::portable_math::exp as pm_exp;
-use crate::state::State;
+use crate::state::{State, BODY_SOLIDIFIED};
 use rayon::prelude::*;
 
 /// Density a particle's volume and heat capacity use: summation density for
@@ -202,7 +204,9 @@ pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
 /// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a
 /// solid whose liquid fraction reaches ½ becomes its liquid phase (at rest), a
 /// liquid whose liquid fraction falls below ½ becomes its solid phase, frozen in
-/// place (velocity and accelerations zeroed).
+/// place (velocity and accelerations zeroed). With rigid bodies, a particle that
+/// solidified is marked `BODY_SOLIDIFIED` for `bodies.melt`, which bonds the
+/// bodies it touches.
 pub fn temperature(pr: &Params, st: &mut State) {
     let n = st.active();
     let State {
@@ -211,6 +215,8 @@ pub fn temperature(pr: &Params, st: &mut State) {
         vel,
         acc,
         acc_b,
+        body,
+        id,
         ..
     } = st;
     heat[..n]
@@ -221,16 +227,15 @@ pub fn temperature(pr: &Params, st: &mut State) {
                 .par_iter_mut()
                 .zip(acc[..n].par_iter_mut().zip(acc_b[..n].par_iter_mut())),
         )
-        .for_each(|((hv, ph), (v, (a, ab)))| {
+        .enumerate()
+        .filter_map(|(i, ((hv, ph), (v, (a, ab))))| {
             if !pr.conducts(*ph) {
-                return;
+                return None;
             }
             let (t, fl) = temperature_of(pr, *ph, hv[0]);
             hv[1] = t;
             hv[2] = fl;
-            let Some(target) = pr.switch_target(*ph) else {
-                return;
-            };
+            let target = pr.switch_target(*ph)?;
             let solid = pr.phases[*ph as usize].kind == KIND_SOLID;
             if solid && fl >= 0.5 {
                 *ph = target;
@@ -239,8 +244,14 @@ pub fn temperature(pr: &Params, st: &mut State) {
                 *v = [0.0; 4];
                 *a = [0.0; 4];
                 *ab = [0.0; 4];
+                return Some(i);
             }
-        });
+            None
+        })
+        .collect::<Vec<usize>>()
+        .into_iter()
+        .filter(|_| pr.flag(FLAG_BODIES))
+        .for_each(|i| body[id[i] as usize] = BODY_SOLIDIFIED);
 }
 
 #[cfg(test)]

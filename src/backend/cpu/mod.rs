@@ -127,6 +127,10 @@ impl CpuBackend {
         bodies::forces(&self.params, &mut self.st, &self.grid);
         bodies::sum(&mut self.st);
     }
+    pub(crate) fn body_melt(&mut self) {
+        bodies::bond(&self.params, &mut self.st, &self.grid);
+        bodies::melt(&self.params, &mut self.st);
+    }
     pub(crate) fn body_kick(&mut self) {
         bodies::kick(&self.params, &mut self.st)
     }

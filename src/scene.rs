@@ -578,7 +578,7 @@ pub struct CheckDef {
     /// Free rotation: the largest relative change of the rotational energy.
     pub energy_tolerance: Option<f64>,
     /// Bed at rest: the time (s) after which no body may move (default: half
-    /// the run).
+    /// the run). Settling: the time after which the fall speed is averaged.
     pub settle_time: Option<f64>,
 }
 
@@ -644,6 +644,8 @@ pub enum CheckKind {
     BedAtRest,
     /// A grain dropped into a melt melts completely, conserving mass and momentum.
     MeltingGrain,
+    /// A 2D disc settling midway between two walls reaches Faxén's terminal velocity.
+    Settling,
 }
 
 impl CheckKind {
@@ -672,6 +674,7 @@ impl CheckKind {
             CheckKind::Flotation => "flotation",
             CheckKind::BedAtRest => "bed_at_rest",
             CheckKind::MeltingGrain => "melting_grain",
+            CheckKind::Settling => "settling",
         }
     }
 }

@@ -454,6 +454,95 @@ impl super::Check for MeltingGrain {
     }
 }
 
+/// Faxén's drag coefficient λ = F/(μ U) (per unit length) of a circular
+/// cylinder of radius a moving parallel to two plane walls midway between them,
+/// half-gap h, k = a/h, in Stokes flow (Faxén 1946, as given by Happel & Brenner
+/// 1965 and used by Ben Richou, Ambari & Naciri 2004): λ = 4π / (ln(1/k) −
+/// 0.9157 + 1.7244 k² − 1.7302 k⁴ + 2.4056 k⁶ − 4.5913 k⁸), for k up to about 0.5.
+pub fn faxen_lambda(k: f64) -> f64 {
+    let k2 = k * k;
+    let series = (1.0 / k).ln() - 0.9157 + 1.7244 * k2 - 1.7302 * k2 * k2 + 2.4056 * k2 * k2 * k2
+        - 4.5913 * k2 * k2 * k2 * k2;
+    4.0 * std::f64::consts::PI / series
+}
+
+/// A 2D disc (the first body) settling in a viscous liquid midway between the
+/// domain's x walls reaches the terminal velocity U = Δρ g π a² / (μ λ(a/h))
+/// (`faxen_lambda`); a is the disc's area radius √(M/(ρ_s π)) (a lattice-filled
+/// disc's particles each stand for Δx², so its wall surface sits half a spacing
+/// outside the outer particles, where the area radius puts it). The measured U is
+/// the mean fall speed from the first sample after `settle_time` to the end;
+/// the metric its relative error.
+#[derive(Default)]
+pub struct Settling {
+    pub settle_time: Option<f64>,
+    /// (time, height of the centre) of the samples past settle_time.
+    samples: Vec<(f64, f64)>,
+}
+
+impl Settling {
+    pub fn new(settle_time: Option<f64>) -> Settling {
+        Settling {
+            settle_time,
+            ..Default::default()
+        }
+    }
+}
+
+impl super::Check for Settling {
+    fn observe(&mut self, _m: &Model, st: &State) {
+        let t = st.sim.time as f64;
+        if st.bodies.is_empty() || t < self.settle_time.unwrap_or(0.0) {
+            return;
+        }
+        self.samples.push((t, st.bodies[0].x[1] as f64));
+    }
+
+    fn verdict(&mut self, m: &Model, st: &State) -> Verdict {
+        let metric = "|U - U_Faxen| / U_Faxen".to_string();
+        let Some(b) = st.bodies.first() else {
+            return (metric, f64::NAN, vec!["no body".into()]).into();
+        };
+        let body_phase = m.bodies[0].phase;
+        let rho_s = m.phases[body_phase].rho0;
+        let liquid = m.phases.iter().find(|p| p.kind == PhaseKind::Liquid);
+        let (rho_f, mu) = liquid.map_or((f64::NAN, f64::NAN), |p| (p.rho0, p.viscosity));
+        let a = (b.x[3] as f64 / (rho_s * std::f64::consts::PI)).sqrt();
+        let half_gap = 0.5 * (m.domain_hi[0] - m.domain_lo[0]);
+        let k = a / half_gap;
+        let g = super::g_mag(m);
+        let lambda = faxen_lambda(k);
+        let u_ref = (rho_s - rho_f) * g * std::f64::consts::PI * a * a / (mu * lambda);
+        if self.samples.is_empty() {
+            return (
+                metric,
+                f64::NAN,
+                vec!["no sample past the settling time".into()],
+            )
+                .into();
+        }
+        // The mean fall speed: the drop of the centre over the time (the body's V
+        // rings with the liquid's acoustic modes, ±0.7 U in the check's scene,
+        // which the drop averages exactly).
+        let (t0, y0) = self.samples[0];
+        let (t1, y1) = *self.samples.last().unwrap();
+        let u = (y0 - y1) / (t1 - t0);
+        let centre = b.x[0] as f64 + m.origin[0];
+        let details = vec![format!(
+            "settling: disc area radius a = {a:.5e} m, k = a/h = {k:.4}, Faxén lambda = {lambda:.4}, Re = {:.3e}; U = {u:.5e} m/s (mean fall speed from t = {t0:.3e} to {t1:.3e} s, {:.3} dx) against U_Faxen = {u_ref:.5e} m/s; the disc's centre {:.3} dx off the channel's midline",
+            rho_f * u * 2.0 * a / mu,
+            (y0 - y1) / m.dx,
+            (centre - 0.5 * (m.domain_hi[0] + m.domain_lo[0])) / m.dx
+        )];
+        Verdict {
+            metric,
+            value: (u - u_ref).abs() / u_ref,
+            details,
+            figures: vec![("u".into(), u), ("u_ref".into(), u_ref)],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     /// Without damping the bounce is elastic; the unclipped dashpot's

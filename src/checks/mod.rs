@@ -145,6 +145,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Flotation => Box::new(bodies::Flotation),
         CheckKind::BedAtRest => Box::new(bodies::AtRest::new(c.settle_time)),
         CheckKind::MeltingGrain => Box::new(bodies::MeltingGrain::default()),
+        CheckKind::Settling => Box::new(bodies::Settling::new(c.settle_time)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

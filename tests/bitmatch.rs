@@ -594,72 +594,7 @@ fn melting_grain_2d_200_steps() {
 /// falls towards the melt.
 #[test]
 fn bonding_grains_2d_200_steps() {
-    let text = r#"
-[simulation]
-dimension = 2
-kernel = "quintic"
-dx = 5.0e-6
-gravity = [0.0, -9.81]
-pressure_floor = true
-
-[domain]
-min = [0.0, 0.0]
-max = [1.5e-4, 1.2e-4]
-wall_phase = "holder"
-open_sides = ["y_max"]
-
-[materials.steel]
-density = 7430.0
-viscosity = 6.0e-3
-sound_speed = 10.0
-conductivity = 35.95
-heat_capacity = 965.0
-solidus = 1695.0
-liquidus = 1705.0
-latent_heat = 2.7e5
-
-[phases.plate]
-kind = "solid"
-material = "steel"
-temperature = 1000.0
-melts_into = "melt"
-
-[phases.melt]
-kind = "liquid"
-material = "steel"
-temperature = 1750.0
-
-[phases.holder]
-kind = "wall"
-material = "steel"
-temperature = 1000.0
-
-[contact]
-stiffness = 1.0e4
-damping = 6.1e-2
-
-[[shapes]]
-phase = "plate"
-box = { min = [0.0, 0.0], max = [1.5e-4, 3.0e-5] }
-
-[[shapes]]
-phase = "melt"
-box = { min = [0.0, 3.0e-5], max = [1.5e-4, 6.0e-5] }
-
-[[shapes]]
-phase = "plate"
-body = true
-sphere = { center = [4.0e-5, 4.6e-5], radius = 1.5e-5 }
-
-[[shapes]]
-phase = "plate"
-body = true
-sphere = { center = [1.1e-4, 9.0e-5], radius = 1.0e-5 }
-velocity = [0.0, -0.3]
-
-[run]
-steps = 200
-"#;
+    let text = common::BONDING_2D;
     let st = assert_bit_identical_text("bonding_2d", text, 200);
     assert_eq!(st.bodies[0].bonded, 1, "the grain in the melt bonded");
     assert_eq!(st.bodies[1].bonded, 0, "the falling grain is still free");

@@ -261,79 +261,16 @@ fn melting_grain_melts_conserving_mass_and_momentum() {
 }
 
 /// Issue 17 item 4, the bonding rule: melt that solidifies within 1.5 Δx of a
-/// rigid grain bonds it into the substrate. A cold grain (1000 K) rests on a
-/// cold plate under a layer of melt at 1750 K: the melt freezes against both and
-/// the grain is bonded; from then on its particles are fixed solid (velocity 0,
+/// rigid grain bonds it into the substrate (`common::BONDING_2D`). A cold grain
+/// (1000 K) rests on a cold plate under a layer of melt at 1750 K: the melt
+/// freezes against both and the grain is bonded; from then on its particles are fixed solid (velocity 0,
 /// no body), and they stay where they were while the run goes on.
 #[test]
 fn solidifying_melt_bonds_a_grain_to_the_substrate() {
     use spatter::backend::{cpu::CpuBackend, Backend};
     let dir = scratch("bodies_bond");
     let path = dir.join("bond.toml");
-    std::fs::write(
-        &path,
-        r#"
-[simulation]
-dimension = 2
-kernel = "quintic"
-dx = 5.0e-6
-gravity = [0.0, -9.81]
-pressure_floor = true
-
-[domain]
-min = [0.0, 0.0]
-max = [1.5e-4, 1.2e-4]
-wall_phase = "holder"
-open_sides = ["y_max"]
-
-[materials.steel]
-density = 7430.0
-viscosity = 6.0e-3
-sound_speed = 10.0
-conductivity = 35.95
-heat_capacity = 965.0
-solidus = 1695.0
-liquidus = 1705.0
-latent_heat = 2.7e5
-
-[phases.plate]
-kind = "solid"
-material = "steel"
-temperature = 1000.0
-melts_into = "melt"
-
-[phases.melt]
-kind = "liquid"
-material = "steel"
-temperature = 1750.0
-
-[phases.holder]
-kind = "wall"
-material = "steel"
-temperature = 1000.0
-
-[contact]
-stiffness = 1.0e4
-damping = 6.1e-2
-
-[[shapes]]
-phase = "plate"
-box = { min = [0.0, 0.0], max = [1.5e-4, 3.0e-5] }
-
-[[shapes]]
-phase = "melt"
-box = { min = [0.0, 3.0e-5], max = [1.5e-4, 6.0e-5] }
-
-[[shapes]]
-phase = "plate"
-body = true
-sphere = { center = [4.0e-5, 4.6e-5], radius = 1.5e-5 }
-
-[run]
-steps = 300
-"#,
-    )
-    .unwrap();
+    std::fs::write(&path, common::BONDING_2D).unwrap();
     let l = spatter::run::load(path.to_str().unwrap(), &[]).unwrap();
     let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
     let mut cpu = CpuBackend::new(params, l.state.clone());

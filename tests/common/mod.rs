@@ -123,3 +123,74 @@ pub fn assert_input_error(args: &[&str], key: &str) {
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(stderr.contains(key), "{args:?}: no `{key}` in {stderr}");
 }
+
+/// Issue 17's bonding scene (tests/bitmatch.rs, tests/bodies.rs): a cold grain
+/// (1000 K) resting on a cold plate under a layer of melt at 1750 K, which
+/// freezes against both and bonds the grain; a second grain falls towards the
+/// melt from above.
+pub const BONDING_2D: &str = r#"
+[simulation]
+dimension = 2
+kernel = "quintic"
+dx = 5.0e-6
+gravity = [0.0, -9.81]
+pressure_floor = true
+
+[domain]
+min = [0.0, 0.0]
+max = [1.5e-4, 1.2e-4]
+wall_phase = "holder"
+open_sides = ["y_max"]
+
+[materials.steel]
+density = 7430.0
+viscosity = 6.0e-3
+sound_speed = 10.0
+conductivity = 35.95
+heat_capacity = 965.0
+solidus = 1695.0
+liquidus = 1705.0
+latent_heat = 2.7e5
+
+[phases.plate]
+kind = "solid"
+material = "steel"
+temperature = 1000.0
+melts_into = "melt"
+
+[phases.melt]
+kind = "liquid"
+material = "steel"
+temperature = 1750.0
+
+[phases.holder]
+kind = "wall"
+material = "steel"
+temperature = 1000.0
+
+[contact]
+stiffness = 1.0e4
+damping = 6.1e-2
+
+[[shapes]]
+phase = "plate"
+box = { min = [0.0, 0.0], max = [1.5e-4, 3.0e-5] }
+
+[[shapes]]
+phase = "melt"
+box = { min = [0.0, 3.0e-5], max = [1.5e-4, 6.0e-5] }
+
+[[shapes]]
+phase = "plate"
+body = true
+sphere = { center = [4.0e-5, 4.6e-5], radius = 1.5e-5 }
+
+[[shapes]]
+phase = "plate"
+body = true
+sphere = { center = [1.1e-4, 9.0e-5], radius = 1.0e-5 }
+velocity = [0.0, -0.3]
+
+[run]
+steps = 200
+"#;

@@ -3,8 +3,9 @@
 // Rigid bodies (F22 2.2, 3.4) in the kick-drift-kick step: half kicks of V and
 // the world angular momentum L, drift, free rotation split into exact turns
 // about the principal axes, members placed at X + R r0; F22 (39)-(40) contact
-// on members; per-body sums over the members in ascending id, one thread per
-// body. Twin of src/backend/cpu/bodies.rs (the derivation is there).
+// on members (and F22 (38): the reaction to the forces pass's pressure, viscous
+// and solid-fluid viscous force on each fluid neighbour); per-body sums over the
+// members in ascending id, one thread per body. Twin of src/backend/cpu/bodies.rs (the derivation is there).
 
 fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(
@@ -119,6 +120,17 @@ fn body_forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             for (var a = 0u; a < 3u; a++) {
                 let u = v_j[a] - v_r[a];
                 f[a] = f[a] - vv * (fp * dj[a] + fv * u);
+            }
+            if (TERM_SOLID_FLUID_VISCOSITY) {
+                // F22 (33) as the forces pass applies it between the melt and a
+                // wall: the fluid's own alpha^sf, mass and sound speed.
+                let alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j].y);
+                let alpha = (alpha_j + alpha_j) * c_half();
+                let c2_j = P.phases[ph_j].c2;
+                let s = solid_fluid_viscosity(m_j, m_j, rho_j, rho_w, c2_j, c2_j, v_j.xyz - v_r.xyz, dj, r2, dwdr, alpha);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] - s * dj[a];
+                }
             }
         }
         let solid_j = kj != NO_BODY || is_wall(phase[j]);

@@ -576,12 +576,16 @@ fn assert_bit_identical_text(name: &str, text: &str, steps: u64) -> spatter::sta
 /// Issue 17 item 4: a rigid grain melting in a pool (the melting-grain check's
 /// scene with the grain just below its solidus, so that 10 of its 52 particles
 /// leave in 200 steps): body_melt's departures (material velocity, own force),
-/// the recomputed mass, centre and principal axes (f32 Jacobi) and F22 (37).
+/// the recomputed mass, centre and principal axes (f32 Jacobi) and F22 (37);
+/// with F22 (33)'s solid–fluid viscosity on, whose reaction the body pass sums.
 #[test]
 fn melting_grain_2d_200_steps() {
     let st = bit_identical_state(
         &common::scene("melting_grain_2d"),
-        &["phases.grain.temperature=1690.0"],
+        &[
+            "phases.grain.temperature=1690.0",
+            "simulation.solid_fluid_viscosity={coefficient=1.0, width=300.0}",
+        ],
         200,
     );
     let b = st.bodies[0];

@@ -83,17 +83,30 @@ pub fn active(params: &Params, name: &str) -> bool {
 }
 
 /// Terms another pass evaluates from the other side of the pair: the rigid-body
-/// pass sums the fluid's pressure and viscous force on each body particle (F22
-/// (38), the reaction f_ri = −m_i a_ir) with the forces pass's own functions.
-pub const REACTION_TERMS: (&str, [&str; 2]) = ("bodies", ["pressure", "viscosity"]);
+/// pass sums the fluid's pressure, viscous and solid–fluid viscous force on each
+/// body particle (F22 (38), the reaction f_ri = −m_i a_ir) with the forces
+/// pass's own functions (`interface_viscosity` because `solid_fluid_viscosity`
+/// is written with it).
+pub const REACTION_TERMS: (&str, [&str; 4]) = (
+    "bodies",
+    [
+        "pressure",
+        "viscosity",
+        "interface_viscosity",
+        "solid_fluid_viscosity",
+    ],
+);
+
+/// Whether `pass`'s WGSL carries term `t` (its own, or a reaction term).
+fn carried(pass: &str, t: &PairTerm) -> bool {
+    t.pass == pass || (pass == REACTION_TERMS.0 && REACTION_TERMS.1.contains(&t.name))
+}
 
 /// The pass's term sources, in registry order (appended to the pass's WGSL).
 pub fn wgsl_for(pass: &str) -> impl Iterator<Item = &'static str> + '_ {
     PAIR_TERMS
         .iter()
-        .filter(move |t| {
-            t.pass == pass || (pass == REACTION_TERMS.0 && REACTION_TERMS.1.contains(&t.name))
-        })
+        .filter(move |t| carried(pass, t))
         .map(|t| t.wgsl)
 }
 
@@ -101,7 +114,7 @@ pub fn wgsl_for(pass: &str) -> impl Iterator<Item = &'static str> + '_ {
 pub fn switches(pass: &str, params: &Params) -> Vec<(&'static str, f64)> {
     PAIR_TERMS
         .iter()
-        .filter(|t| t.pass == pass)
+        .filter(|t| carried(pass, t))
         .filter_map(|t| {
             t.switch
                 .map(|s| (s, if (t.active)(params) { 1.0 } else { 0.0 }))

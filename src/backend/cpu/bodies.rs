@@ -21,7 +21,8 @@
 //! Forces on a body particle r: F22 (39)–(40) contact with every particle of
 //! another body and with wall and solid particles within Δx,
 //!   f = (k_c g + d_c ġ) e if positive,  g = Δx − r,  ġ = −e·(u_r − u_s),
-//! and F22 (38), the fluid's reaction (see `forces`), written (as a force, N)
+//! and F22 (38), the fluid's reaction (see `forces`: pressure, viscosity and
+//! F22 (33)'s solid–fluid viscosity), written (as a force, N)
 //! into acc; the per-body sums run over the members in
 //! ascending id, one thread per body, so the bits do not depend on the thread
 //! count (DESIGN rule 5).
@@ -179,6 +180,8 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
     let (rho, press, mass, vel) = (&st.rho, &st.press, &st.mass, &st.vel);
     let bp = &pr.bodies;
     let reach2 = bp.contact_distance * bp.contact_distance;
+    let sf = crate::backend::terms::active(pr, "solid_fluid_viscosity");
+    let heat = &st.heat;
     st.acc[..n].par_iter_mut().enumerate().for_each(|(i, a)| {
         let k = body[id[i] as usize];
         if k == NO_BODY {
@@ -207,6 +210,19 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                 for c in 0..3 {
                     let u = v_j[c] - v_r[c];
                     f[c] -= vv * (fp * dj[c] + fv * u);
+                }
+                if sf {
+                    // F22 (33) as the forces pass applies it between the melt
+                    // and a wall: the fluid's own α^sf, mass and sound speed.
+                    let alpha_j = terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][1]);
+                    let alpha = (alpha_j + alpha_j) * 0.5;
+                    let u = [v_j[0] - v_r[0], v_j[1] - v_r[1], v_j[2] - v_r[2]];
+                    let s = terms::solid_fluid_viscosity(
+                        pr, m_j, m_j, rho_j, rho_w, mat.c2, mat.c2, u, dj, r2, dwdr, alpha,
+                    );
+                    for c in 0..3 {
+                        f[c] -= s * dj[c];
+                    }
                 }
             }
             if kj == k || r2 >= reach2 || r2 <= 0.0 {

@@ -310,7 +310,7 @@ fn solidifying_melt_bonds_a_grain_to_the_substrate() {
 
 /// The settling check: a disc of 1.5 times the liquid's density settles midway
 /// between two walls at Faxén's Stokes terminal velocity within 5% (the issue;
-/// measured 3.1% fast at a = 5 dx, Re = 0.008).
+/// measured 3.1% fast at a = 5 dx, Re = 0.008; 0.014% at a = 10 dx).
 #[test]
 fn settling_disc_reaches_faxen_terminal_velocity() {
     let out = run_passes("settling_disc_2d", &[]);

@@ -258,6 +258,18 @@ fn melting_grain_melts_conserving_mass_and_momentum() {
         out.contains("52 body particles at the start, 0 left"),
         "{out}"
     );
+    // The /bodies channel says so: tools/spatter_read.py summary.
+    let mcap = scratch("bodies_melting").join("m.mcap");
+    run_passes("melting_grain_2d", &["--out", mcap.to_str().unwrap()]);
+    let s = reader(&["summary", mcap.to_str().unwrap()]);
+    let (stdout, stderr) = text(&s);
+    assert_eq!(s.status.code(), Some(0), "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(
+        (v["bodies_molten"].as_u64(), v["bodies_bonded"].as_u64()),
+        (Some(1), Some(0)),
+        "{stdout}"
+    );
     // With F22 (33)'s solid–fluid viscosity between the melt and the grain, whose
     // reaction the body pass sums too (without it: 16.5% of |P0| lost).
     run_passes(

@@ -5,7 +5,8 @@ Set up its environment once (from the repository root):
     python3 -m venv .venv && .venv/bin/pip install -r tools/requirements.txt
 
 Commands:
-    spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span, removals
+    spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span, removals,
+                                                 rigid bodies (count, bonded, molten away at the end)
     spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
     spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
     spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
@@ -19,7 +20,7 @@ info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
 speed, mass); info["track"] is the /track message of a laser scene (None
 without); info["bodies"] the /bodies messages of a scene with rigid bodies (one
 per frame: time, and per body its position, orientation, velocity, angular
-velocity, mass); read_vtu(path) -> {field: numpy array}.
+velocity, mass, particles, molten_fraction, bonded); read_vtu(path) -> {field: numpy array}.
 A file whose writer was killed (no summary) is read up to its last complete chunk.
 """
 import json
@@ -166,6 +167,11 @@ def summary(path):
         "schemas": info["schemas"],
         "track_slices": len(info["track"]["slices"]) if info["track"] else None,
         "bodies": len(info["bodies"][-1]["bodies"]) if info["bodies"] else 0,
+        "bodies_bonded": sum(1 for b in info["bodies"][-1]["bodies"] if b.get("bonded"))
+        if info["bodies"] else 0,
+        "bodies_molten": sum(1 for b in info["bodies"][-1]["bodies"]
+                             if b.get("particles") == 0 and not b.get("bonded"))
+        if info["bodies"] else 0,
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),
     }

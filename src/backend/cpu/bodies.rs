@@ -295,7 +295,8 @@ pub fn kick(pr: &Params, st: &mut State) {
 }
 
 /// Particles that solidified this step bond the bodies they touch: within this
-/// reach (in Δx) of a body particle, which covers a lattice's diagonal neighbour.
+/// reach (in Δx) of a body particle, which covers a lattice's diagonal neighbour
+/// (the WGSL twin reads it as `c_one_and_half()`).
 pub const BOND_REACH: f32 = 1.5;
 
 /// `body_bond`: a particle that solidified in this step (`BODY_SOLIDIFIED`, set
@@ -327,7 +328,8 @@ pub fn bond(pr: &Params, st: &mut State, grid: &CellTable) {
 /// `body_melt`, F22 (37) and the bonding rule, per body with a member that
 /// melted or was touched by solidifying melt (the rest are left as they are):
 /// - touched (`body_offset.w` set): the body is bonded into the substrate: its
-///   solid members become fixed solid particles (at rest), count 0;
+///   solid members become fixed solid particles (at rest), still listed, and
+///   `bonded` stops every body pass;
 /// - otherwise the melted members leave: each keeps its material velocity
 ///   V + ω × r as a fluid particle; the rest are the new body, with its mass,
 ///   centre and principal axes recomputed from their body-frame offsets, ω

@@ -242,7 +242,7 @@ fn bond_body(k: u32) {
         body[m_id] = NO_BODY;
         if (!is_wall(phase[i])) {
             // Its force leaves with it; the rest goes into the substrate.
-            let f = release(b, m_id, i);
+            _ = release(b, m_id, i);
             continue;
         }
         members[b.first + kept] = m_id;

@@ -219,6 +219,7 @@ pub fn temperature(pr: &Params, st: &mut State) {
         id,
         ..
     } = st;
+    let bodies = pr.flag(FLAG_BODIES);
     heat[..n]
         .par_iter_mut()
         .zip(phase[..n].par_iter_mut())
@@ -244,13 +245,13 @@ pub fn temperature(pr: &Params, st: &mut State) {
                 *v = [0.0; 4];
                 *a = [0.0; 4];
                 *ab = [0.0; 4];
-                return Some(i);
+                // Only rigid-body scenes need to know (bodies.melt).
+                return bodies.then_some(i);
             }
             None
         })
         .collect::<Vec<usize>>()
         .into_iter()
-        .filter(|_| pr.flag(FLAG_BODIES))
         .for_each(|i| body[id[i] as usize] = BODY_SOLIDIFIED);
 }
 

@@ -1,4 +1,5 @@
-// uses: params bindings consts kernel grid phase rigid
+// uses: params consts kernel grid phase rigid
+// reads: rho press mass phase id heat sim
 // writes: pos vel acc acc_b body body_offset bodies members slots
 // Rigid bodies (F22 2.2, 3.4) in the kick-drift-kick step: half kicks of V and
 // the world angular momentum L, drift, free rotation split into exact turns

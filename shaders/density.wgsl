@@ -1,4 +1,5 @@
-// uses: params bindings kernel grid phase
+// uses: params kernel grid phase
+// reads: pos mass phase
 // writes: rho press
 // Summation density rho_i = m_i sum_j W_ij (F22 §3.3) and EOS p = c²(rho - rho0)
 // (F22 (3)), clamped at 0 with the pressure floor. Twin of src/backend/cpu/density.rs.

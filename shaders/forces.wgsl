@@ -1,4 +1,5 @@
-// uses: params bindings consts kernel grid phase
+// uses: params consts kernel grid phase
+// reads: pos vel rho press mass phase heat surface
 // writes: acc acc_b
 // Pressure + viscous forces F22 (23), transport-velocity background pressure
 // (Adami 2013), interface viscosity F22 (31), solid-fluid viscosity F22 (33),

@@ -1,5 +1,6 @@
-// uses: params bindings consts kernel grid phase math vapour
-// writes: acc acc_b heat phase vel body
+// uses: params consts kernel grid phase math vapour
+// reads: pos rho mass id surface sim
+// writes: acc acc_b heat phase vel body heat_start solvers partials
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
@@ -24,6 +25,10 @@ fn heat_density(ph: u32, i: u32) -> f32 {
 fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i >= active_particles()) { return; }
+    mirror_temperature(i);
+}
+
+fn mirror_temperature(i: u32) {
     let ph = phase[i];
     if (conducts(ph) || (heat_flags(ph) & HEAT_DIRICHLET) == 0u) { return; }
     let pi = pos[i];
@@ -49,12 +54,11 @@ fn wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_
     heat[i] = hv;
 }
 
-@compute @workgroup_size(64)
-fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = thread_index(gid, nwg);
-    if (i >= active_particles()) { return; }
+// dh_i/dt of conducting particle i at the temperatures in heat.y (and liquid
+// fractions in heat.z): conduction, the laser's source (W/kg), viscous heating,
+// minus the surface losses.
+fn conduction_rate(i: u32, laser_source: f32) -> f32 {
     let ph_i = phase[i];
-    if (!conducts(ph_i)) { return; }
     let k_i = conductivity(ph_i, heat[i].z);
     let t_i = heat[i].y;
     let eta2 = P.kernel.eta2;
@@ -81,11 +85,7 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         let v_j = mass[j] / heat_density(ph_j, j);
         sum = sum + v_j * k_ij * (t_i - heat[j].y) * f;
     }
-    // The laser pass left its source (W/kg) in heat.w.
-    var source = 0.0;
-    if (P.laser.model != 0u) {
-        source = heat[i].w;
-    }
+    var source = laser_source;
     if ((P.sizes.flags & FLAG_VISCOUS_HEATING) != 0u) {
         source = source + acc[i].w;
     }
@@ -93,12 +93,148 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if ((P.sizes.flags & FLAG_INTERFACE) != 0u) {
         loss = surface_loss(ph_i, t_i, surface[i].w);
     }
-    let rate = source - loss + sum / heat_density(ph_i, i);
+    return source - loss + sum / heat_density(ph_i, i);
+}
+
+// The laser pass left its source (W/kg) in heat.w.
+fn laser_source(i: u32) -> f32 {
+    if (P.laser.model != 0u) {
+        return heat[i].w;
+    }
+    return 0.0;
+}
+
+@compute @workgroup_size(64)
+fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    if (!conducts(phase[i])) { return; }
+    let rate = conduction_rate(i, laser_source(i));
     // Neighbours read only T (.y), so the enthalpy can be updated in place.
     var hv = heat[i];
     hv.x = hv.x + sim.dt * rate;
     hv.w = rate;
     heat[i] = hv;
+}
+
+// Implicit midpoint (R18 Algorithm 3.1), fixed-point iteration; twin of the
+// functions after `conduct` in src/backend/cpu/heat.rs (equations there).
+// heat_begin: heat_start = (h^n, laser source, 0, 0), heat.w (the rate) 0; the
+// solver reset.
+@compute @workgroup_size(64)
+fn heat_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i == 0u) {
+        solvers[SOLVER_HEAT] = Solver(0u, 0u, 0.0, 0u);
+    }
+    if (i >= active_particles()) { return; }
+    if (conducts(phase[i])) {
+        var hv = heat[i];
+        heat_start[i] = vec4<f32>(hv.x, laser_source(i), 0.0, 0.0);
+        hv.w = 0.0;
+        heat[i] = hv;
+    } else {
+        heat_start[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+}
+
+fn heat_converged() -> bool {
+    return solvers[SOLVER_HEAT].converged != 0u;
+}
+
+// T and f_l at the midpoint enthalpy (h^n + h^k) / 2.
+@compute @workgroup_size(64)
+fn iterate_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if (heat_converged()) { return; }
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let ph = phase[i];
+    if (!conducts(ph)) { return; }
+    var hv = heat[i];
+    let tf = temperature_of(ph, (heat_start[i].x + hv.x) * c_half());
+    hv.y = tf.x;
+    hv.z = tf.y;
+    heat[i] = hv;
+}
+
+@compute @workgroup_size(64)
+fn iterate_wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if (heat_converged()) { return; }
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    mirror_temperature(i);
+}
+
+// h^{k+1} = h^n + dt rate_k(T_mid); |rate_k - rate_{k-1}| and |rate_k| to
+// heat_start.zw (the rates, not the enthalpies: (a + b) - a is what lavapipe
+// would fold to b). Neighbours read only T and f_l (.y, .z): in place.
+@compute @workgroup_size(64)
+fn iterate_conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if (heat_converged()) { return; }
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    if (!conducts(phase[i])) { return; }
+    var hs = heat_start[i];
+    let rate = conduction_rate(i, hs.y);
+    var hv = heat[i];
+    hs.z = abs(rate - hv.w);
+    hs.w = abs(rate);
+    hv.x = hs.x + sim.dt * rate;
+    hv.w = rate;
+    heat_start[i] = hs;
+    heat[i] = hv;
+}
+
+// Max over conducting particles of heat_start.zw by the two-level tree of the
+// time step (timestep.wgsl): per workgroup into partials, then one workgroup.
+const HWG: u32 = 256u;
+var<workgroup> hred: array<vec2<f32>, 256>;
+
+fn heat_tree_max(t: u32) {
+    for (var s = HWG / 2u; s > 0u; s = s / 2u) {
+        workgroupBarrier();
+        if (t < s) {
+            hred[t] = max(hred[t], hred[t + s]);
+        }
+    }
+    workgroupBarrier();
+}
+
+@compute @workgroup_size(256)
+fn heat_residual(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if (heat_converged()) { return; }
+    let g = wid.x + wid.y * nwg.x;
+    let i = g * HWG + t;
+    var m = vec2<f32>(0.0, 0.0);
+    if (i < active_particles() && conducts(phase[i])) {
+        m = heat_start[i].zw;
+    }
+    hred[t] = m;
+    heat_tree_max(t);
+    if (t == 0u) {
+        partials[g] = hred[0];
+    }
+}
+
+@compute @workgroup_size(256)
+fn heat_residual_final(@builtin(local_invocation_index) t: u32) {
+    if (heat_converged()) { return; }
+    let groups = (P.sizes.n_particles + HWG - 1u) / HWG;
+    var m = vec2<f32>(0.0, 0.0);
+    for (var g = t; g < groups; g += HWG) {
+        m = max(m, partials[g]);
+    }
+    hred[t] = m;
+    heat_tree_max(t);
+    if (t != 0u) { return; }
+    var s = solvers[SOLVER_HEAT];
+    s.iterations = s.iterations + 1u;
+    s.residual = 0.0;
+    if (hred[0].y > 0.0) {
+        s.residual = hred[0].x / hred[0].y;
+    }
+    s.converged = select(0u, 1u, s.residual <= P.solve.heat_tolerance);
+    solvers[SOLVER_HEAT] = s;
 }
 
 // Evaporation F22 (18), (10) and radiation through the free surface, W/kg.
@@ -115,36 +251,38 @@ fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
     return flux * delta / P.phases[ph].rho0;
 }
 
+// (T, f_l) of the stored enthalpy h (relative to h(T_ref); T_ref = solidus when
+// the phase melts). Twin of temperature_of in src/backend/cpu/heat.rs.
+fn temperature_of(ph: u32, h: f32) -> vec2<f32> {
+    let c_s = P.phases[ph].heat_capacity;
+    let band = P.phases[ph].band_enthalpy;
+    let t_s = P.phases[ph].solidus;
+    let t_l = P.phases[ph].liquidus;
+    let flags = heat_flags(ph);
+    if ((flags & HEAT_MELTS) == 0u) {
+        return vec2<f32>(P.phases[ph].reference_temperature + h / c_s, select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u));
+    } else if (h <= 0.0) {
+        return vec2<f32>(t_s + h / c_s, 0.0);
+    } else if (h >= band) {
+        return vec2<f32>(t_l + (h - band) / P.phases[ph].liquid_heat_capacity, 1.0);
+    }
+    let a = P.phases[ph].capacity_slope;
+    let b = P.phases[ph].band_capacity;
+    let x = c_two() * h / (b + sqrt(b * b + c_four() * a * h));
+    return vec2<f32>(t_s + x, x / (t_l - t_s));
+}
+
 @compute @workgroup_size(64)
 fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i >= active_particles()) { return; }
     let ph = phase[i];
     if (!conducts(ph)) { return; }
-    var hv = heat[i];
-    let h = hv.x;
-    let c_s = P.phases[ph].heat_capacity;
-    let band = P.phases[ph].band_enthalpy;
-    let t_s = P.phases[ph].solidus;
-    let t_l = P.phases[ph].liquidus;
     let flags = heat_flags(ph);
-    // Stored enthalpy is relative to h(T_ref) (T_ref = solidus when melting).
-    if ((flags & HEAT_MELTS) == 0u) {
-        hv.y = P.phases[ph].reference_temperature + h / c_s;
-        hv.z = select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u);
-    } else if (h <= 0.0) {
-        hv.y = t_s + h / c_s;
-        hv.z = 0.0;
-    } else if (h >= band) {
-        hv.y = t_l + (h - band) / P.phases[ph].liquid_heat_capacity;
-        hv.z = 1.0;
-    } else {
-        let a = P.phases[ph].capacity_slope;
-        let b = P.phases[ph].band_capacity;
-        let x = c_two() * h / (b + sqrt(b * b + c_four() * a * h));
-        hv.y = t_s + x;
-        hv.z = x / (t_l - t_s);
-    }
+    var hv = heat[i];
+    let tf = temperature_of(ph, hv.x);
+    hv.y = tf.x;
+    hv.z = tf.y;
     heat[i] = hv;
     // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).
     let switch_to = (flags >> HEAT_SWITCH_SHIFT) & 15u;

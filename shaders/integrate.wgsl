@@ -1,4 +1,5 @@
-// uses: params bindings consts grid phase
+// uses: params consts grid phase
+// reads: acc acc_b phase heat sim
 // writes: pos vel
 // Velocity Verlet with transport velocity. Twin of src/backend/cpu/integrate.rs.
 

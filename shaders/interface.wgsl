@@ -1,4 +1,5 @@
-// uses: params bindings consts kernel grid phase
+// uses: params consts kernel grid phase
+// reads: pos rho mass phase heat
 // writes: surface
 // Interface normal and surface delta of the condensed material, R18 (3.25)-(3.27).
 // Twin of src/backend/cpu/interface.rs (equations there). surface[i] = (n, delta),

@@ -1,4 +1,5 @@
-// uses: params bindings consts grid phase math
+// uses: params consts grid phase math
+// reads: pos mass phase surface sim
 // writes: bins heat
 // Beer-Lambert laser absorption with column binning (R18 §3.2.2), beam down the
 // last axis. Twin of src/backend/cpu/laser.rs (equations there).

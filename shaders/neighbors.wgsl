@@ -1,5 +1,6 @@
-// uses: params bindings grid phase
-// writes: keys cell_start cell_end s_pos s_vel s_acc s_acc_b s_mass s_phase s_id s_heat sim
+// uses: params grid phase
+// reads: pos phase
+// writes: keys cell_start cell_end cell_fluid sim
 // Neighbour search. Twin of src/backend/cpu/neighbors.rs.
 // 1. cell_keys: key (cell, index) per particle; a particle that has left the
 //    domain gets cell n_cells (after every cell), padding keys sort last.

@@ -1,4 +1,5 @@
-// uses: params bindings consts kernel grid phase math vapour
+// uses: params consts kernel grid phase math vapour
+// reads: pos rho mass phase heat
 // writes: acc surface
 // Forces at the interface, added to the acceleration the forces pass wrote:
 // surface_tension, CSF with Marangoni stress F22 (24)-(26), (8), (21) between the

@@ -1,4 +1,5 @@
-// uses: params bindings consts grid phase
+// uses: params consts grid phase
+// reads: vel acc phase
 // writes: sim partials
 // Max |u|² and |a|² over fluid particles by a fixed two-level tree (per-workgroup,
 // then one workgroup over the partials), then the F22 (42) time step.

@@ -1,4 +1,5 @@
-// uses: params bindings consts kernel grid phase rigid
+// uses: params consts kernel grid phase rigid
+// reads: pos phase id body bodies cell_fluid
 // writes: rho press vel
 // Generalized wall boundary (Adami, Hu & Adams 2012): each wall particle gathers
 // pressure and velocity from its fluid neighbours. Twin of src/backend/cpu/wall.rs.

@@ -4,13 +4,14 @@
 //! Layout (little-endian): magic `SPATCKPT`, u32 format version, u32 reserved,
 //! u64 header length, JSON header, then the arrays in `State` order (pos, vel, acc,
 //! acc_b as 4×f32; rho, p, mass as f32; phase, id as u32; heat as 4×f32 in heat
-//! scenes; the interface and body arrays where held), the body table and member
-//! list (scenes with rigid bodies), the 32-byte `Sim`
+//! scenes; the interface, body and heat_start arrays where held), the tables
+//! (crate::fields::TABLES: body table, member list, solver slots; their lengths
+//! in the header), the 32-byte `Sim`
 //! block, and a CRC-32 of everything before it. Files are written to a temporary
 //! name and renamed, so a checkpoint on disk is always complete.
 
 use crate::error::InputError;
-use crate::fields::{Held, FIELDS};
+use crate::fields::{Held, FIELDS, TABLES};
 use crate::model::Model;
 use crate::output::write_atomic;
 use crate::state::{Sim, State};
@@ -23,7 +24,9 @@ const MAGIC: &[u8; 8] = b"SPATCKPT";
 // 3: rigid bodies (body, body_offset, the body table and member list).
 // 4: a body's particle inertia (inertia.w), bonded flag and initial member count
 // (melting bodies; version 3 bodies would recompute with zero particle inertia).
-const FORMAT_VERSION: u32 = 4;
+// 5: every table of crate::fields::TABLES (bodies, members, solvers) with its
+// length in the header's `tables`; the implicit heat's heat_start field.
+const FORMAT_VERSION: u32 = 5;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
 const KEEP: usize = 2;
@@ -49,13 +52,16 @@ pub struct Header {
     /// The interface array (2n × 4 f32) follows the heat array.
     #[serde(default)]
     pub surface: bool,
-    /// Rigid bodies: the body and body_offset arrays follow, and after the
-    /// particle arrays the body table (`bodies` × 128 bytes) and the member list
-    /// (`members` × u32).
+    /// Rigid bodies: the body and body_offset arrays follow the interface array.
     #[serde(default)]
-    pub bodies: u64,
+    pub bodies: bool,
+    /// Implicit-midpoint heat: the heat_start array follows.
     #[serde(default)]
-    pub members: u64,
+    pub heat_start: bool,
+    /// Entries of each table (crate::fields::TABLES), stored after the particle
+    /// arrays in registry order; a table not named here is empty.
+    #[serde(default)]
+    pub tables: std::collections::BTreeMap<String, u64>,
 }
 
 pub struct Checkpoint {
@@ -81,8 +87,12 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         rng_draws_after_setup: 0,
         heat: !st.heat.is_empty(),
         surface: !st.surface.is_empty(),
-        bodies: st.bodies.len() as u64,
-        members: st.members.len() as u64,
+        bodies: !st.body.is_empty(),
+        heat_start: !st.heat_start.is_empty(),
+        tables: TABLES
+            .iter()
+            .map(|t| (t.name.to_string(), t.entries(st) as u64))
+            .collect(),
     };
     let json = serde_json::to_vec(&header).expect("checkpoint header serializes");
     let mut out = Vec::with_capacity(64 + json.len() + st.len() * 100);
@@ -95,8 +105,9 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
     for f in FIELDS.iter().filter(|f| f.checkpointed) {
         push(&mut out, (f.words)(st));
     }
-    push(&mut out, &st.bodies);
-    push(&mut out, &st.members);
+    for t in &TABLES {
+        push(&mut out, (t.words)(st));
+    }
     out.extend_from_slice(bytemuck::bytes_of(&st.sim));
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -155,7 +166,9 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
     let held = Held {
         heat: header.heat,
         interface: header.surface,
-        bodies: header.bodies > 0,
+        bodies: header.bodies,
+        implicit_heat: header.heat_start,
+        solvers: false, // a table, not a particle array
     };
     let mut state = State::default();
     for f in FIELDS.iter().filter(|f| f.checkpointed) {
@@ -163,10 +176,11 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         let bytes = c.take(count * f.bytes_per_particle()).ok_or_else(short)?;
         (f.set)(&mut state, bytes);
     }
-    let body_bytes = header.bodies as usize * std::mem::size_of::<crate::state::Body>();
-    state.bodies = bytemuck::pod_collect_to_vec(c.take(body_bytes).ok_or_else(short)?);
-    state.members =
-        bytemuck::pod_collect_to_vec(c.take(header.members as usize * 4).ok_or_else(short)?);
+    for t in &TABLES {
+        let entries = header.tables.get(t.name).copied().unwrap_or(0) as usize;
+        let bytes = c.take(entries * t.components * 4).ok_or_else(short)?;
+        (t.set)(&mut state, bytes);
+    }
     state.sim =
         bytemuck::pod_read_unaligned::<Sim>(c.take(std::mem::size_of::<Sim>()).ok_or_else(short)?);
     if c.at != body.len() {

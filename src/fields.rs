@@ -25,14 +25,20 @@ pub enum Holder {
     Interface,
     /// Scenes with rigid bodies.
     Bodies,
+    /// Heat integrated by the implicit midpoint rule (R18 Algorithm 3.1).
+    ImplicitHeat,
+    /// Scenes whose schedule holds a repeat (solver slots).
+    Solvers,
 }
 
 /// The scene's holders, from the pipeline's features.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Held {
     pub heat: bool,
     pub interface: bool,
     pub bodies: bool,
+    pub implicit_heat: bool,
+    pub solvers: bool,
 }
 
 impl Held {
@@ -42,6 +48,8 @@ impl Held {
             Holder::Heat => self.heat,
             Holder::Interface => self.interface,
             Holder::Bodies => self.bodies,
+            Holder::ImplicitHeat => self.implicit_heat,
+            Holder::Solvers => self.solvers,
         }
     }
     /// What a state holds (its optional arrays are empty when not held).
@@ -50,6 +58,22 @@ impl Held {
             heat: !st.heat.is_empty(),
             interface: !st.surface.is_empty(),
             bodies: !st.body.is_empty(),
+            implicit_heat: !st.heat_start.is_empty(),
+            solvers: !st.solvers.is_empty(),
+        }
+    }
+    /// What a scene holds, from its model (the same as its schedule's features:
+    /// `backend::Pipeline::held`, checked in tests/fields.rs).
+    pub fn of_model(m: &crate::model::Model) -> Held {
+        let implicit_heat = m.is_thermal()
+            && m.heat.integrator == crate::scene::HeatIntegrator::ImplicitMidpoint;
+        Held {
+            heat: m.is_thermal(),
+            interface: m.needs_interface(),
+            bodies: m.has_bodies(),
+            implicit_heat,
+            // The implicit heat is the only repeat so far.
+            solvers: implicit_heat,
         }
     }
 }
@@ -117,7 +141,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 13] = [
+pub const FIELDS: [FieldDef; 14] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -143,7 +167,62 @@ pub const FIELDS: [FieldDef; 13] = [
         Some(output::body_channels)),
     field!("body_offset", body_offset, "body_offset", None, 4, 1, true, Holder::Bodies,
         None),
+    // Written by heat.begin every step after the sort (no scratch needed).
+    field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
+        None),
 ];
+
+/// The state's arrays that are not per particle: one row each, read the same way
+/// as a field by checkpoints (which store each table's length in their header),
+/// `compare`, the GPU upload and readback.
+pub struct TableDef {
+    /// Name in `compare` reports and checkpoint headers; also its WGSL binding.
+    pub name: &'static str,
+    /// 32-bit words per entry.
+    pub components: usize,
+    pub is_float: bool,
+    /// Its WGSL element type (the buffer is `array<wgsl>`).
+    pub wgsl: &'static str,
+    pub holder: Holder,
+    pub words: fn(&State) -> &[u32],
+    pub set: fn(&mut State, &[u8]),
+    /// Entries the GPU buffer holds at least (a binding must hold one element).
+    pub min_entries: usize,
+}
+
+macro_rules! table {
+    ($name:literal, $array:ident, $components:literal, $float:literal, $wgsl:literal,
+     $holder:expr, $min:literal) => {
+        TableDef {
+            name: $name,
+            components: $components,
+            is_float: $float,
+            wgsl: $wgsl,
+            holder: $holder,
+            words: |s| bytemuck::cast_slice(&s.$array),
+            set: |s, b| s.$array = bytemuck::pod_collect_to_vec(b),
+            min_entries: $min,
+        }
+    };
+}
+
+/// Every table, in checkpoint and `compare` order.
+#[rustfmt::skip]
+pub const TABLES: [TableDef; 3] = [
+    // One row per rigid body (state::Body, 32 words); the wall pass declares the
+    // table in every scene, so its buffer holds one entry at least.
+    table!("bodies", bodies, 32, true, "Body", Holder::Bodies, 1),
+    // Member particle ids, body after body.
+    table!("members", members, 1, false, "u32", Holder::Bodies, 0),
+    // One state::Solver per solver slot (backend::schedule::SOLVER_SLOTS).
+    table!("solvers", solvers, 4, false, "Solver", Holder::Solvers, 1),
+];
+
+impl TableDef {
+    pub fn entries(&self, st: &State) -> usize {
+        (self.words)(st).len() / self.components
+    }
+}
 
 /// out[k] = v[perm[k]], in parallel.
 fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[usize]) {
@@ -209,11 +288,25 @@ mod tests {
 
     #[test]
     fn names_and_bindings_are_unique() {
-        for (k, f) in FIELDS.iter().enumerate() {
-            for g in &FIELDS[k + 1..] {
-                assert_ne!(f.name, g.name);
-                assert_ne!(f.binding, g.binding);
-            }
+        let mut names: Vec<&str> = FIELDS.iter().flat_map(|f| [f.name, f.binding]).collect();
+        names.extend(FIELDS.iter().filter_map(|f| f.scratch));
+        names.extend(TABLES.iter().map(|t| t.name));
+        for (k, a) in names.iter().enumerate() {
+            // A field's name may equal its own binding; nothing else may repeat.
+            let own = FIELDS.iter().any(|f| f.name == *a && f.binding == *a);
+            let again = names[k + 1..].iter().filter(|b| *b == a).count();
+            assert!(again <= own as usize, "{a} repeats");
+        }
+    }
+
+    #[test]
+    fn table_rows_read_and_write_their_own_array() {
+        let mut st = State::default();
+        for (k, t) in TABLES.iter().enumerate() {
+            let words: Vec<u32> = (0..t.components as u32).map(|w| 100 * k as u32 + w).collect();
+            (t.set)(&mut st, bytemuck::cast_slice(&words));
+            assert_eq!((t.words)(&st), &words[..], "{}", t.name);
+            assert_eq!(t.entries(&st), 1, "{}", t.name);
         }
     }
 }

@@ -499,8 +499,9 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     let st = &loaded.state;
     println!("scenario: {path}");
     println!(
-        "dimension: {}, formulation: wcsph, kernel: {} (h = {:.4e} m, support {:.4e} m), dx = {:.4e} m",
+        "dimension: {}, formulation: {}, kernel: {} (h = {:.4e} m, support {:.4e} m), dx = {:.4e} m",
         m.dim,
+        m.formulation.name(),
         m.kernel.name(),
         m.h,
         m.support,
@@ -565,10 +566,9 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
         None => println!("time step: adaptive, initially {lim:.4e} s"),
     }
     let params = Params::new(m, st.len() as u32);
-    println!(
-        "passes: {}",
-        Pipeline::for_scene(&params, st).pass_names().join(", ")
-    );
+    let pipeline = Pipeline::for_scene(&params, st);
+    println!("passes: {}", pipeline.pass_names().join(", "));
+    println!("step: {}", pipeline.describe_step());
     Ok(ExitCode::SUCCESS)
 }
 

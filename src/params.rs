@@ -325,6 +325,24 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// The formulation and its solvers (backend::schedule).
+    pub struct Solve {
+        /// `Formulation::code`.
+        pub formulation: u32,
+        /// HEAT_EULER or HEAT_IMPLICIT_MIDPOINT.
+        pub heat_integrator: u32,
+        /// Implicit midpoint: converged when max|h^{k+1} − h^k| ≤ this × max|h^{k+1} − h^n|.
+        pub heat_tolerance: f32,
+        /// Implicit midpoint: the repeat's bound.
+        pub heat_max_iterations: u32,
+    }
+}
+
+/// `solve.heat_integrator` codes.
+pub const HEAT_EULER: u32 = 0;
+pub const HEAT_IMPLICIT_MIDPOINT: u32 = 1;
+
+gpu_struct! {
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
     /// reassociates a product with a literal constant (measured: `6.0 * (a * a)`
     /// differs from Rust in 10% of inputs, the same 6.0 from a buffer never), so
@@ -379,6 +397,7 @@ gpu_struct! {
         pub tension: Tension,
         pub laser: Laser,
         pub bodies: Bodies,
+        pub solve: Solve,
         pub phases: [Phase; MAX_PHASES],
         pub consts: Consts,
     }
@@ -500,6 +519,15 @@ impl Params {
                 contact_distance: m.dx as f32,
             };
         }
+        p.solve = Solve {
+            formulation: m.formulation.code(),
+            heat_integrator: match m.heat.integrator {
+                crate::scene::HeatIntegrator::Euler => HEAT_EULER,
+                crate::scene::HeatIntegrator::ImplicitMidpoint => HEAT_IMPLICIT_MIDPOINT,
+            },
+            heat_tolerance: m.heat.tolerance as f32,
+            heat_max_iterations: m.heat.max_iterations,
+        };
         p.consts = SHADER_CONSTS;
         if m.needs_interface() {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);

@@ -54,6 +54,62 @@ pub enum Formulation {
     Wcsph,
 }
 
+impl Formulation {
+    /// Its code in the parameter block (`solve.formulation`).
+    pub fn code(self) -> u32 {
+        match self {
+            Formulation::Wcsph => 0,
+        }
+    }
+    pub fn from_code(code: u32) -> Formulation {
+        match code {
+            0 => Formulation::Wcsph,
+            c => panic!("no formulation with code {c}"),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Formulation::Wcsph => "wcsph",
+        }
+    }
+}
+
+/// `[heat] integrator`: how the enthalpy advances over a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeatIntegrator {
+    /// h^{n+1} = h^n + Δt ḣ(T^n) (F22, J22).
+    #[default]
+    Euler,
+    /// h^{n+1} = h^n + Δt ḣ(T((h^n + h^{n+1})/2)), by fixed-point iteration
+    /// (R18 Algorithm 3.1).
+    ImplicitMidpoint,
+}
+
+/// `[heat]`: the time integration of the energy equation (heat scenes only).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeatDef {
+    #[serde(default)]
+    pub integrator: HeatIntegrator,
+    /// Implicit midpoint: iterate until max|h^{k+1} − h^k| / max|h^{k+1} − h^n|
+    /// (the change of the iterate against the step's) is at most this (R18
+    /// prints no value).
+    #[serde(default = "default_heat_tolerance")]
+    pub tolerance: f64,
+    /// Implicit midpoint: at most this many iterations per step (each is a
+    /// conduction sweep; the GPU records them all).
+    #[serde(default = "default_heat_iterations")]
+    pub max_iterations: u32,
+}
+
+fn default_heat_tolerance() -> f64 {
+    1e-4
+}
+fn default_heat_iterations() -> u32 {
+    8
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PhaseKind {
@@ -102,6 +158,7 @@ pub struct SceneFile {
     pub surface_tension: Option<SurfaceTensionDef>,
     pub powder: Option<PowderDef>,
     pub contact: Option<ContactDef>,
+    pub heat: Option<HeatDef>,
 }
 
 /// `[contact]`: F22 (39)–(40), the repulsive spring–dashpot between particles of

@@ -55,11 +55,7 @@ fn axis_sites_len(m: &Model, a: usize) -> f64 {
 
 /// Estimated memory of the scene in bytes.
 pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
-    let held = crate::fields::Held {
-        heat: m.is_thermal(),
-        interface: m.needs_interface(),
-        bodies: m.has_bodies(),
-    };
+    let held = crate::fields::Held::of_model(m);
     let per_particle = crate::fields::bytes_per_particle(held) as u64 + BYTES_PER_PARTICLE_SORT;
     particles * per_particle as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
 }
@@ -359,8 +355,15 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     if let Some(axis) = m.hydrostatic_axis {
         hydrostatic_start(m, &mut st, &sites, axis);
     }
-    if m.needs_interface() {
+    let held = crate::fields::Held::of_model(m);
+    if held.interface {
         st.surface = vec![[0.0; 4]; 2 * st.len()];
+    }
+    if held.implicit_heat {
+        st.heat_start = vec![[0.0; 4]; st.len()];
+    }
+    if held.solvers {
+        st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];
     }
     Ok(st)
 }

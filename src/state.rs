@@ -76,7 +76,26 @@ pub struct State {
     /// Particle ids of every body's members, body after body in ascending id
     /// (`Body::first`, `Body::count`): the fixed order of the per-body sums.
     pub members: Vec<u32>,
+    /// Implicit-midpoint heat only (empty otherwise): h^n, the laser source of
+    /// the step, and the last iteration's |ḣ_k − ḣ_{k−1}| and |ḣ_k|.
+    pub heat_start: Vec<[f32; 4]>,
+    /// Scenes whose schedule holds a repeat (empty otherwise): one entry per
+    /// solver slot (backend::schedule::SOLVER_SLOTS), this step's iterations,
+    /// flag and residual.
+    pub solvers: Vec<Solver>,
     pub sim: Sim,
+}
+
+/// One solver's progress in the current step (WGSL twin `Solver` in
+/// shaders/lib/params.wgsl): reset by its repeat's begin stage.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable, Default)]
+pub struct Solver {
+    pub iterations: u32,
+    /// 1 once the residual fell to the tolerance: the loop's kernels return at once.
+    pub converged: u32,
+    pub residual: f32,
+    pub _pad: u32,
 }
 
 /// `State::body` of a particle that belongs to no body.
@@ -156,7 +175,7 @@ impl State {
         self.len() - (self.sim.removed as usize).min(self.len())
     }
     /// The compared fields this state holds, in registry order (crate::fields),
-    /// then the body table (32 words per body) in scenes with rigid bodies.
+    /// then its tables (crate::fields::TABLES) that are not empty.
     pub fn fields(&self) -> Vec<FieldView<'_>> {
         let held = crate::fields::Held::of_state(self);
         let mut out: Vec<FieldView<'_>> = crate::fields::FIELDS
@@ -169,14 +188,17 @@ impl State {
                 is_float: f.is_float,
             })
             .collect();
-        if !self.bodies.is_empty() {
-            out.push(FieldView {
-                name: "bodies",
-                components: 32,
-                words: bytemuck::cast_slice(&self.bodies),
-                is_float: true,
-            });
-        }
+        out.extend(
+            crate::fields::TABLES
+                .iter()
+                .filter(|t| !(t.words)(self).is_empty())
+                .map(|t| FieldView {
+                    name: t.name,
+                    components: t.components,
+                    words: (t.words)(self),
+                    is_float: t.is_float,
+                }),
+        );
         out
     }
 }

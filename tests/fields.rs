@@ -1,68 +1,149 @@
-//! The field registry (spatter::fields), the GPU binding table
-//! (backend::gpu::BINDINGS) and shaders/lib/bindings.wgsl describe the same
-//! buffers: each binding number holds the buffer the table names, and each field's
-//! WGSL array has the field's element type. Checked through naga, so a field added
-//! or moved on one side only fails here.
+//! The buffer registry (spatter::fields::FIELDS and TABLES, the GPU's
+//! DEVICE_BUFFERS) and the WGSL passes describe the same buffers: each pass binds
+//! exactly what its header names (`// reads:`, `// writes:`, its libraries'
+//! `// reads:`), numbered in registry order, read-only unless written; each
+//! field's WGSL array has the field's element type. Checked through naga on the
+//! composed sources, so a buffer used but not named, or named but declared
+//! differently, fails here.
 
-use spatter::backend::gpu::BINDINGS;
-use spatter::fields::FIELDS;
+use spatter::backend::gpu::{bindable, pass_bindings, shader_sources};
+use spatter::fields::{FIELDS, TABLES};
 
-const BINDINGS_WGSL: &str = concat!(
-    include_str!("../shaders/lib/params.wgsl"),
-    "\n",
-    include_str!("../shaders/lib/bindings.wgsl")
-);
+/// The per-stage storage-buffer limit this project must fit (lavapipe's and
+/// wgpu's default `max_storage_buffers_per_shader_stage`).
+const MAX_STORAGE_BUFFERS_PER_PASS: usize = 8 * 4;
 
-/// (binding number, name, element type) of every global in group 0.
-fn wgsl_bindings() -> Vec<(u32, String, naga::TypeInner)> {
-    let module = naga::front::wgsl::parse_str(BINDINGS_WGSL).unwrap();
-    let mut out: Vec<(u32, String, naga::TypeInner)> = module
+/// (binding, name, writable) of every group-0 global of a composed pass.
+fn reflected(name: &str, src: &str) -> Vec<(u32, String, bool)> {
+    let module = naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(src)));
+    let mut out: Vec<(u32, String, bool)> = module
         .global_variables
         .iter()
         .filter_map(|(_, g)| {
-            let b = g.binding.as_ref()?;
-            assert_eq!(b.group, 0);
-            let elem = match &module.types[g.ty].inner {
-                naga::TypeInner::Array { base, .. } => module.types[*base].inner.clone(),
-                other => other.clone(),
+            // Group 1 is the sort's stage uniform (neighbors.wgsl), not a buffer.
+            let b = g.binding.as_ref().filter(|b| b.group == 0)?;
+            let writable = match g.space {
+                naga::AddressSpace::Storage { access } => {
+                    access.contains(naga::StorageAccess::STORE)
+                }
+                _ => false,
             };
-            Some((b.binding, g.name.clone().unwrap_or_default(), elem))
+            Some((b.binding, g.name.clone().unwrap_or_default(), writable))
         })
         .collect();
     out.sort_by_key(|b| b.0);
     out
 }
 
-#[test]
-fn binding_table_matches_the_wgsl() {
-    let wgsl = wgsl_bindings();
-    let names: Vec<(u32, &str)> = wgsl.iter().map(|(b, n, _)| (*b, n.as_str())).collect();
-    let table: Vec<(u32, &str)> = BINDINGS
+fn pass_source(name: &str) -> &'static str {
+    spatter::backend::gpu::shaders::PASSES
         .iter()
-        .enumerate()
-        .map(|(b, n)| (b as u32, *n))
-        .collect();
-    assert_eq!(table, names);
+        .find(|(n, _)| *n == name)
+        .unwrap()
+        .1
 }
 
 #[test]
-fn every_field_and_scratch_is_bound_with_its_element_type() {
-    let wgsl = wgsl_bindings();
+fn each_pass_binds_what_its_header_names() {
+    for (name, composed) in shader_sources() {
+        let header = pass_bindings(pass_source(name)).unwrap();
+        let mut want: Vec<(u32, String, bool)> = vec![(0, "P".to_string(), false)];
+        want.extend(
+            header
+                .iter()
+                .map(|b| (b.binding, b.name.to_string(), b.read_write())),
+        );
+        assert_eq!(reflected(name, &composed), want, "{name}.wgsl");
+        assert!(
+            header.len() <= MAX_STORAGE_BUFFERS_PER_PASS,
+            "{name}: {} storage buffers",
+            header.len()
+        );
+    }
+}
+
+/// A pass's `// writes:` line is complete: naga rejects a store to a buffer
+/// declared `read`, so every pass validates only if it is (tests/shaders.rs
+/// validates them all); here, the converse: a written buffer is declared
+/// read_write and an unwritten one read-only.
+#[test]
+fn written_buffers_are_read_write_and_the_rest_read_only() {
+    let src = "// uses: params\n// reads: pos vel\n// writes: acc\nfn f() {}\n";
+    let b = pass_bindings(src).unwrap();
+    let get = |n: &str| b.iter().find(|x| x.name == n).unwrap().read_write();
+    assert!(get("acc"));
+    assert!(!get("pos") && !get("vel"));
+}
+
+/// Every field, scratch and table is declared with its row's element type.
+#[test]
+fn every_buffer_has_its_rows_element_type() {
+    let mut src = String::from(include_str!("../shaders/lib/params.wgsl"));
+    for (k, b) in bindable().iter().enumerate() {
+        src.push_str(&format!(
+            "@group(0) @binding({}) var<storage, read_write> {}: {};\n",
+            k + 1,
+            b.name,
+            b.wgsl
+        ));
+    }
+    let module = naga::front::wgsl::parse_str(&src).unwrap();
+    let elem = |name: &str| -> naga::TypeInner {
+        let g = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no binding {name}"))
+            .1;
+        match &module.types[g.ty].inner {
+            naga::TypeInner::Array { base, .. } => module.types[*base].inner.clone(),
+            other => other.clone(),
+        }
+    };
     for f in &FIELDS {
         for name in std::iter::once(f.binding).chain(f.scratch) {
-            let (_, _, elem) = wgsl
-                .iter()
-                .find(|(_, n, _)| n == name)
-                .unwrap_or_else(|| panic!("{}: no WGSL binding {name}", f.name));
-            let (components, scalar) = match elem {
-                naga::TypeInner::Scalar(s) => (1, *s),
-                naga::TypeInner::Vector { size, scalar } => (*size as usize, *scalar),
+            let (components, scalar) = match elem(name) {
+                naga::TypeInner::Scalar(s) => (1, s),
+                naga::TypeInner::Vector { size, scalar } => (size as usize, scalar),
                 other => panic!("{name}: {other:?}"),
             };
             assert_eq!(components, f.components, "{name}");
             assert_eq!(scalar.width, 4, "{name}");
-            let float = scalar.kind == naga::ScalarKind::Float;
-            assert_eq!(float, f.is_float, "{name}");
+            assert_eq!(scalar.kind == naga::ScalarKind::Float, f.is_float, "{name}");
         }
+    }
+    for t in &TABLES {
+        let size = match elem(t.name) {
+            naga::TypeInner::Struct { span, .. } => span as usize,
+            naga::TypeInner::Scalar(s) => s.width as usize,
+            other => panic!("{}: {other:?}", t.name),
+        };
+        assert_eq!(size, 4 * t.components, "{}", t.name);
+    }
+}
+
+/// What setup allocates (fields::Held::of_model) is what the schedule runs on
+/// (Pipeline::held), for every validation scene.
+#[test]
+fn the_models_holders_are_the_schedules() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/validation");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let l = spatter::run::load(path.to_str().unwrap(), &[]).unwrap();
+        let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
+        let pipeline = spatter::backend::Pipeline::for_scene(&params, &l.state);
+        assert_eq!(
+            spatter::fields::Held::of_model(&l.model),
+            pipeline.held(),
+            "{}",
+            path.display()
+        );
+        assert_eq!(
+            spatter::fields::Held::of_state(&l.state),
+            pipeline.held(),
+            "{}",
+            path.display()
+        );
     }
 }

@@ -139,6 +139,10 @@ fn wgsl_params_match_rust_member_for_member() {
         naga_struct_size(PARAMS_WGSL, "Body") as usize,
         std::mem::size_of::<spatter::state::Body>()
     );
+    assert_eq!(
+        naga_struct_size(PARAMS_WGSL, "Solver") as usize,
+        std::mem::size_of::<spatter::state::Solver>()
+    );
 }
 
 /// The check itself: a member renamed or moved on one side only is reported.
@@ -217,6 +221,12 @@ fn flag_and_code_constants_match() {
         ("PHASE_MOVES", rs::PHASE_MOVES),
         ("LASER_BEER_LAMBERT", rs::LASER_BEER_LAMBERT),
         ("LASER_SURFACE", rs::LASER_SURFACE),
+        ("HEAT_EULER", rs::HEAT_EULER),
+        ("HEAT_IMPLICIT_MIDPOINT", rs::HEAT_IMPLICIT_MIDPOINT),
+        (
+            "SOLVER_HEAT",
+            spatter::backend::SolverSlot::Heat as u32,
+        ),
     ];
     for (name, v) in expected {
         assert_eq!(value(name), v, "{name}");

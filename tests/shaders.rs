@@ -8,7 +8,17 @@ use spatter::backend::gpu::shader_sources;
 #[test]
 fn every_shader_validates() {
     let sources = shader_sources();
-    assert!(sources.len() >= 9, "all pass shaders listed");
+    // Every pass file of the pass table is composed, and every composed file
+    // belongs to a stage.
+    for d in spatter::backend::STAGES.iter() {
+        assert!(sources.iter().any(|(n, _)| *n == d.file), "no shaders/{}.wgsl", d.file);
+    }
+    for (name, _) in &sources {
+        assert!(
+            spatter::backend::STAGES.iter().any(|d| d.file == *name),
+            "shaders/{name}.wgsl has no stage"
+        );
+    }
     for (name, source) in sources {
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&source)));

@@ -1,4 +1,5 @@
-// uses: params bindings
+// uses: params
+// reads: cell_start cell_end sim
 // Thread indexing, the cell grid and the neighbour walk's helpers. Twin of
 // src/backend/cpu/neighbors.rs. The walk itself is written once, as the
 // #for_each_neighbor template (src/backend/gpu/shaders.rs expands it).

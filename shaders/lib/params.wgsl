@@ -115,6 +115,13 @@ struct Bodies {              // rigid bodies, F22 (39)-(40) contact (FLAG_BODIES
     contact_distance: f32,   // dx
 }
 
+struct Solve {                // the formulation and its solvers (backend::schedule)
+    formulation: u32,
+    heat_integrator: u32,     // HEAT_EULER, HEAT_IMPLICIT_MIDPOINT
+    heat_tolerance: f32,
+    heat_max_iterations: u32,
+}
+
 struct Phase {
     rho0: f32,
     c2: f32,                 // sound speed squared
@@ -194,6 +201,7 @@ struct Params {
     tension: Tension,
     laser: Laser,
     bodies: Bodies,
+    solve: Solve,
     phases: array<Phase, 8>,
     consts: Consts,
 }
@@ -206,6 +214,15 @@ struct Sim {
     umax2: f32,
     amax2: f32,
     removed: u32,            // particles taken out, sorted last (issue 18)
+    pad0: u32,
+}
+
+// One solver's state in this step: twin of src/state.rs `Solver`, one per slot
+// of backend::schedule::SOLVER_SLOTS (SOLVER_* below).
+struct Solver {
+    iterations: u32,         // iterations run since the repeat began
+    converged: u32,          // 1: the residual fell to the tolerance; the loop's kernels return
+    residual: f32,           // the last iteration's residual
     pad0: u32,
 }
 
@@ -251,4 +268,7 @@ const PHASE_MOVES: u32 = 8192u;
 const PHASE_RECOIL: u32 = 16384u;
 const LASER_BEER_LAMBERT: u32 = 1u;
 const LASER_SURFACE: u32 = 2u;
+const HEAT_EULER: u32 = 0u;
+const HEAT_IMPLICIT_MIDPOINT: u32 = 1u;
+const SOLVER_HEAT: u32 = 0u;
 const WG: u32 = 64u;

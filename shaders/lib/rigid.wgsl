@@ -1,4 +1,4 @@
-// uses: params bindings consts
+// uses: params consts
 // Rigid-body math: twin of the helpers in src/backend/cpu/bodies.rs, same
 // operations in the same order. Every sum is written as one left-to-right chain
 // of products, never "a + (b - c)": lavapipe rewrites that as (a + b) - c (found

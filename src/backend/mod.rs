@@ -1,50 +1,20 @@
-//! The two backends behind one interface. A step is a fixed sequence of stages
-//! (passes.rs: the pass table, its order and the features that select stages);
-//! each stage has WGSL entry points and a Rust twin of the same name.
+//! The two backends behind one interface. A step is a formulation's schedule
+//! (schedule.rs: nodes, each a stage or a bounded repeat) over the pass table
+//! (passes.rs: each stage's WGSL entry points, when each runs, and its CPU twin).
 
 pub mod cpu;
 pub mod gpu;
 
 mod passes;
+mod schedule;
 pub mod terms;
 
-pub use passes::{entry_points, Dispatch, Features, Stage, StageDef, Work, PRIME, STAGES, STEP};
+pub use passes::{entry_points, Dispatch, Features, Stage, StageDef, Twin, Work, STAGES};
+pub use schedule::{
+    formulation, FormulationDef, Node, Pipeline, Repeat, SolverSlot, FORMULATIONS, SOLVER_SLOTS,
+};
 
-use crate::params::Params;
 use crate::state::{Sim, State};
-
-/// The stages a scene runs: only what its physics needs (DESIGN.md). A scene
-/// without wall particles has no wall pass, a scene without fluid no flow passes,
-/// a scene without temperature no heat pass (and no heat buffers).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Pipeline {
-    pub features: Features,
-    pub step: Vec<Stage>,
-    pub prime: Vec<Stage>,
-}
-
-impl Pipeline {
-    pub fn for_scene(params: &Params, st: &State) -> Pipeline {
-        let features = Features::of(params, st);
-        let needed = |s: &&Stage| (s.def().needed)(&features);
-        Pipeline {
-            features,
-            step: STEP.iter().filter(needed).copied().collect(),
-            prime: PRIME.iter().filter(needed).copied().collect(),
-        }
-    }
-    /// Pass names (WGSL files), each once, in the pass table's order, for
-    /// `spatter validate`.
-    pub fn pass_names(&self) -> Vec<&'static str> {
-        let mut names: Vec<&'static str> = Vec::new();
-        for d in STAGES.iter().filter(|d| self.step.contains(&d.stage)) {
-            if !names.contains(&d.file) {
-                names.push(d.file);
-            }
-        }
-        names
-    }
-}
 
 /// The device stopped answering: lost, or a readback that never completed. The
 /// run that meets it closes its outputs at the last state it read back.
@@ -71,18 +41,35 @@ pub trait Backend {
     /// without it: what the steps then compute is not the scene's physics.
     fn skip_stage(&mut self, stage: Stage);
     fn run_stage(&mut self, stage: Stage);
+    /// One node of the schedule. A repeat runs its begin stage, then its stages
+    /// `max_iterations` times: after the solver's flag is set every kernel of the
+    /// loop returns at once (both backends), so running them all gives the state
+    /// an early stop gives (the CPU stops early).
+    fn run_node(&mut self, node: &Node) {
+        match node {
+            Node::Stage(s) => self.run_stage(*s),
+            Node::Repeat(r) => {
+                self.run_stage(r.begin);
+                for _ in 0..r.max_iterations {
+                    for &s in &r.stages {
+                        self.run_stage(s);
+                    }
+                }
+            }
+        }
+    }
     /// Run `n` whole steps without reading anything back.
     fn run_steps(&mut self, n: u32) {
         let step = self.pipeline().step.clone();
         for _ in 0..n {
-            for &s in &step {
-                self.run_stage(s);
+            for node in &step {
+                self.run_node(node);
             }
         }
     }
     fn prime(&mut self) {
-        for s in self.pipeline().prime.clone() {
-            self.run_stage(s);
+        for node in self.pipeline().prime.clone() {
+            self.run_node(&node);
         }
     }
     fn read_state(&mut self) -> Result<State, DeviceLost>;

@@ -1,12 +1,13 @@
-//! The pass table: every stage of a step, in one place, with its WGSL entry points
-//! and the work each dispatches over, the scene features that need it, and its CPU
-//! twin. `STEP` and `PRIME` give the order; `Pipeline::for_scene` keeps the stages
-//! a scene needs; both backends run whatever the pipeline lists.
+//! The pass table: every stage of a step, in one place, with its WGSL entry points,
+//! the work each dispatches over, when it runs, and the CPU twin of each. The order
+//! of a step is a formulation's schedule (backend::schedule); both backends run
+//! whatever the schedule lists, dispatch by dispatch from these rows.
 
 use super::cpu::CpuBackend;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
-    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, LASER_BEER_LAMBERT, LASER_SURFACE,
+    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_IMPLICIT_MIDPOINT, LASER_BEER_LAMBERT,
+    LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -48,44 +49,16 @@ pub enum Stage {
     /// Melting rigid bodies: melted members leave (F22 (37)), bodies touched by
     /// solidifying melt bond into the substrate.
     BodyMelt,
+    /// Implicit-midpoint heat (R18 Algorithm 3.1): keep h^n and the laser source,
+    /// reset the heat solver.
+    HeatBegin,
+    /// One fixed-point iteration: T at the midpoint enthalpy, the Dirichlet
+    /// mirrors, conduction and h^{k+1} = h^n + Δt ḣ(T_mid).
+    HeatIterate,
+    /// The iteration's residual max|ḣ_k − ḣ_{k−1}| / max|ḣ_k| and the solver's
+    /// converged flag.
+    HeatResidual,
 }
-
-/// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
-/// inside it: heat is explicit Euler, conduction reading the temperatures of the
-/// previous step, then the temperatures following the new enthalpies.
-pub const STEP: [Stage; 16] = [
-    Stage::KickDrift,     // v += Δt/2 a, x += Δt ṽ (transport velocity)
-    Stage::BodyDrift,     // bodies: V, L += Δt/2 (F, τ); X += Δt V; rotate; place
-    Stage::Neighbors,     // sort by cell, cell table
-    Stage::Density,       // ρ = m Σ W, p = c² (ρ − ρ0)
-    Stage::Wall,          // wall pressure and velocity extrapolated from the fluid
-    Stage::Interface,     // interface normals and surface delta
-    Stage::Forces,        // pressure, viscous forces, barrier; gravity
-    Stage::SurfaceForces, // surface tension, Marangoni stress, recoil
-    Stage::BodyForces,    // contact on body particles; per-body F, τ
-    Stage::Laser,         // absorbed laser power
-    Stage::Heat,          // conduction and surface losses, enthalpy update
-    Stage::Temperature,   // T and f_l from h; melting and solidification
-    Stage::BodyMelt,      // bodies: melted members leave, solidified melt bonds
-    Stage::Kick,          // v += Δt/2 a
-    Stage::BodyKick,      // bodies: V, L += Δt/2 (F, τ)
-    Stage::Timestep,      // Δt for the next step
-];
-
-/// Run once before the first step: accelerations, temperatures and Δt of the
-/// initial state.
-pub const PRIME: [Stage; 10] = [
-    Stage::Neighbors,
-    Stage::Density,
-    Stage::Wall,
-    Stage::Interface,
-    Stage::Forces,
-    Stage::SurfaceForces,
-    Stage::BodyForces,
-    Stage::Temperature,
-    Stage::BodyMelt,
-    Stage::Timestep,
-];
 
 /// What a scene has; it decides which stages and dispatches run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,6 +87,8 @@ pub struct Features {
     pub recoil: bool,
     /// Rigid bodies (F22 §2.2).
     pub bodies: bool,
+    /// Heat integrated by the implicit midpoint rule (R18 Algorithm 3.1).
+    pub implicit_heat: bool,
 }
 
 impl Features {
@@ -135,6 +110,8 @@ impl Features {
             wetting: params.flag(FLAG_WETTING),
             recoil: params.flag(FLAG_RECOIL),
             bodies: params.flag(FLAG_BODIES),
+            implicit_heat: params.flag(FLAG_HEAT)
+                && params.solve.heat_integrator == HEAT_IMPLICIT_MIDPOINT,
         }
     }
 }
@@ -160,240 +137,288 @@ pub enum Work {
     Bodies,
 }
 
-/// One GPU entry point of a stage, dispatched when `when` holds.
+/// The CPU twin of one dispatch.
+#[derive(Clone, Copy)]
+pub enum Twin {
+    /// This function computes what the dispatch computes.
+    Run(fn(&mut CpuBackend)),
+    /// The twin of an earlier dispatch of the same stage already did this work
+    /// (the sort inside `neighbors`, the second level of a reduction); the row
+    /// says which in a comment.
+    InPrevious,
+}
+
+/// One GPU entry point of a stage, dispatched when `when` holds, and its CPU twin
+/// (run under the same condition).
 pub struct Dispatch {
     pub entry: &'static str,
     pub work: Work,
     pub when: fn(&Features) -> bool,
+    pub cpu: Twin,
 }
 
-const fn always(entry: &'static str, work: Work) -> Dispatch {
+const fn always(entry: &'static str, work: Work, cpu: fn(&mut CpuBackend)) -> Dispatch {
     Dispatch {
         entry,
         work,
         when: |_| true,
+        cpu: Twin::Run(cpu),
+    }
+}
+
+const fn when(
+    entry: &'static str,
+    work: Work,
+    when: fn(&Features) -> bool,
+    cpu: fn(&mut CpuBackend),
+) -> Dispatch {
+    Dispatch {
+        entry,
+        work,
+        when,
+        cpu: Twin::Run(cpu),
+    }
+}
+
+/// A dispatch whose CPU work the stage's previous twin did.
+const fn within(entry: &'static str, work: Work) -> Dispatch {
+    Dispatch {
+        entry,
+        work,
+        when: |_| true,
+        cpu: Twin::InPrevious,
     }
 }
 
 /// One stage: its name (timings, `compare`, `validate`), its WGSL file, the
-/// features that need it, its GPU entry points in dispatch order and its CPU twin.
+/// features that need it, and its dispatches in order with their CPU twins.
 pub struct StageDef {
     pub stage: Stage,
     pub name: &'static str,
     pub file: &'static str,
     pub needed: fn(&Features) -> bool,
-    pub gpu: &'static [Dispatch],
-    pub cpu: fn(&mut CpuBackend),
+    pub dispatches: &'static [Dispatch],
 }
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 16] = [
+pub const STAGES: [StageDef; 19] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
         file: "neighbors",
         needed: |_| true,
         // Cell keys, stable (cell, index) sort, reorder, cell table; the buffer
-        // copies between them are encoded by the GPU backend.
-        gpu: &[
-            always("cell_keys", Work::SortKeys),
-            always("bitonic_local", Work::Sort),
-            always("bitonic_global", Work::Sort),
-            always("reorder", Work::Particles),
-            always("cell_bounds", Work::Particles),
+        // copies between them are encoded by the GPU backend. The CPU sorts and
+        // builds the cell table in one twin.
+        dispatches: &[
+            always("cell_keys", Work::SortKeys, |b| b.neighbors()),
+            within("bitonic_local", Work::Sort),
+            within("bitonic_global", Work::Sort),
+            within("reorder", Work::Particles),
+            within("cell_bounds", Work::Particles),
         ],
-        cpu: |b| b.neighbors(),
     },
     StageDef {
         stage: Stage::Density,
         name: "density",
         file: "density",
         needed: |f| f.fluid,
-        gpu: &[always("density", Work::Particles)],
-        cpu: |b| b.density(),
+        dispatches: &[always("density", Work::Particles, |b| b.density())],
     },
     StageDef {
         stage: Stage::Wall,
         name: "wall",
         file: "wall",
         needed: |f| f.walls && f.fluid,
-        gpu: &[always("wall", Work::Particles)],
-        cpu: |b| b.wall(),
+        dispatches: &[always("wall", Work::Particles, |b| b.wall())],
     },
     StageDef {
         stage: Stage::Interface,
         name: "interface",
         file: "interface",
         needed: |f| f.interface,
-        gpu: &[
-            Dispatch {
-                entry: "shepard",
-                work: Work::Particles,
-                when: |f| !f.gas_interface,
-            },
-            always("normals", Work::Particles),
-            Dispatch {
-                entry: "wetting",
-                work: Work::Particles,
-                when: |f| f.wetting,
-            },
+        dispatches: &[
+            when("shepard", Work::Particles, |f| !f.gas_interface, |b| b.shepard()),
+            always("normals", Work::Particles, |b| b.normals()),
+            when("wetting", Work::Particles, |f| f.wetting, |b| b.wetting()),
         ],
-        cpu: |b| b.interface(),
     },
     StageDef {
         stage: Stage::Forces,
         name: "forces",
         file: "forces",
         needed: |f| f.fluid,
-        gpu: &[always("forces", Work::Particles)],
-        cpu: |b| b.forces(),
+        dispatches: &[always("forces", Work::Particles, |b| b.forces())],
     },
     StageDef {
         stage: Stage::SurfaceForces,
         name: "surface_forces",
         file: "surface_forces",
         needed: |f| f.surface_tension || f.recoil,
-        gpu: &[
-            Dispatch {
-                entry: "surface_tension",
-                work: Work::Particles,
-                when: |f| f.surface_tension && !f.free_surface_tension,
-            },
-            Dispatch {
-                entry: "tension_curvature",
-                work: Work::Particles,
-                when: |f| f.free_surface_tension,
-            },
-            Dispatch {
-                entry: "tension_smooth",
-                work: Work::Particles,
-                when: |f| f.free_surface_tension,
-            },
-            Dispatch {
-                entry: "recoil",
-                work: Work::Particles,
-                when: |f| f.recoil,
-            },
+        dispatches: &[
+            when(
+                "surface_tension",
+                Work::Particles,
+                |f| f.surface_tension && !f.free_surface_tension,
+                |b| b.surface_tension(),
+            ),
+            when(
+                "tension_curvature",
+                Work::Particles,
+                |f| f.free_surface_tension,
+                |b| b.tension_curvature(),
+            ),
+            when(
+                "tension_smooth",
+                Work::Particles,
+                |f| f.free_surface_tension,
+                |b| b.tension_smooth(),
+            ),
+            when("recoil", Work::Particles, |f| f.recoil, |b| b.recoil()),
         ],
-        cpu: |b| b.surface_forces(),
     },
     StageDef {
         stage: Stage::Laser,
         name: "laser",
         file: "laser",
         needed: |f| f.laser_bins || f.laser_surface,
-        gpu: &[
-            Dispatch {
-                entry: "laser_surface",
-                work: Work::Particles,
-                when: |f| f.laser_surface,
-            },
-            Dispatch {
-                entry: "laser_bins",
-                work: Work::LaserBins,
-                when: |f| f.laser_bins,
-            },
-            Dispatch {
-                entry: "laser_columns",
-                work: Work::LaserColumns,
-                when: |f| f.laser_bins,
-            },
-            Dispatch {
-                entry: "laser_deposit",
-                work: Work::Particles,
-                when: |f| f.laser_bins,
-            },
+        dispatches: &[
+            when(
+                "laser_surface",
+                Work::Particles,
+                |f| f.laser_surface,
+                |b| b.laser_surface(),
+            ),
+            when("laser_bins", Work::LaserBins, |f| f.laser_bins, |b| b.laser_bins()),
+            when(
+                "laser_columns",
+                Work::LaserColumns,
+                |f| f.laser_bins,
+                |b| b.laser_columns(),
+            ),
+            when(
+                "laser_deposit",
+                Work::Particles,
+                |f| f.laser_bins,
+                |b| b.laser_deposit(),
+            ),
         ],
-        cpu: |b| b.laser(),
     },
     StageDef {
         stage: Stage::Heat,
         name: "heat.conduct",
         file: "heat",
         needed: |f| f.heat,
-        gpu: &[
-            always("wall_temperature", Work::Particles),
-            always("conduct", Work::Particles),
+        dispatches: &[
+            always("wall_temperature", Work::Particles, |b| b.wall_temperature()),
+            always("conduct", Work::Particles, |b| b.conduct()),
         ],
-        cpu: |b| b.conduct(),
+    },
+    StageDef {
+        stage: Stage::HeatBegin,
+        name: "heat.begin",
+        file: "heat",
+        needed: |f| f.implicit_heat,
+        dispatches: &[always("heat_begin", Work::Particles, |b| b.heat_begin())],
+    },
+    StageDef {
+        stage: Stage::HeatIterate,
+        name: "heat.iterate",
+        file: "heat",
+        needed: |f| f.implicit_heat,
+        dispatches: &[
+            always("iterate_temperature", Work::Particles, |b| {
+                b.iterate_temperature()
+            }),
+            always("iterate_wall_temperature", Work::Particles, |b| {
+                b.iterate_wall_temperature()
+            }),
+            always("iterate_conduct", Work::Particles, |b| b.iterate_conduct()),
+        ],
+    },
+    StageDef {
+        stage: Stage::HeatResidual,
+        name: "heat.residual",
+        file: "heat",
+        needed: |f| f.implicit_heat,
+        // One twin for both levels of the max tree.
+        dispatches: &[
+            always("heat_residual", Work::Reduction, |b| b.heat_residual()),
+            within("heat_residual_final", Work::Single),
+        ],
     },
     StageDef {
         stage: Stage::Temperature,
         name: "heat.temperature",
         file: "heat",
         needed: |f| f.heat,
-        gpu: &[always("temperature", Work::Particles)],
-        cpu: |b| b.temperature(),
+        dispatches: &[always("temperature", Work::Particles, |b| b.temperature())],
     },
     StageDef {
         stage: Stage::KickDrift,
         name: "integrate.kick_drift",
         file: "integrate",
         needed: |f| f.fluid,
-        gpu: &[always("kick_drift", Work::Particles)],
-        cpu: |b| b.kick_drift(),
+        dispatches: &[always("kick_drift", Work::Particles, |b| b.kick_drift())],
     },
     StageDef {
         stage: Stage::Kick,
         name: "integrate.kick",
         file: "integrate",
         needed: |f| f.fluid,
-        gpu: &[always("kick", Work::Particles)],
-        cpu: |b| b.kick(),
+        dispatches: &[always("kick", Work::Particles, |b| b.kick())],
     },
     StageDef {
         stage: Stage::Timestep,
         name: "timestep",
         file: "timestep",
         needed: |_| true,
-        gpu: &[
-            always("reduce", Work::Reduction),
-            always("finalize", Work::Single),
+        // One twin for both levels of the max tree and the limits.
+        dispatches: &[
+            always("reduce", Work::Reduction, |b| b.timestep()),
+            within("finalize", Work::Single),
         ],
-        cpu: |b| b.timestep(),
     },
     StageDef {
         stage: Stage::BodyDrift,
         name: "bodies.drift",
         file: "bodies",
         needed: |f| f.bodies,
-        gpu: &[
-            always("body_drift", Work::Bodies),
-            always("body_place", Work::Particles),
+        dispatches: &[
+            always("body_drift", Work::Bodies, |b| b.body_drift()),
+            always("body_place", Work::Particles, |b| b.body_place()),
         ],
-        cpu: |b| b.body_drift(),
     },
     StageDef {
         stage: Stage::BodyForces,
         name: "bodies.forces",
         file: "bodies",
         needed: |f| f.bodies,
-        gpu: &[
-            always("body_forces", Work::Particles),
-            always("body_slots", Work::Particles),
-            always("body_sum", Work::Bodies),
+        // The CPU sums by particle id directly (its twin of body_sum builds the
+        // id -> index map that body_slots writes on the GPU).
+        dispatches: &[
+            always("body_forces", Work::Particles, |b| b.body_forces()),
+            within("body_slots", Work::Particles),
+            always("body_sum", Work::Bodies, |b| b.body_sum()),
         ],
-        cpu: |b| b.body_forces(),
     },
     StageDef {
         stage: Stage::BodyKick,
         name: "bodies.kick",
         file: "bodies",
         needed: |f| f.bodies,
-        gpu: &[always("body_kick", Work::Bodies)],
-        cpu: |b| b.body_kick(),
+        dispatches: &[always("body_kick", Work::Bodies, |b| b.body_kick())],
     },
     StageDef {
         stage: Stage::BodyMelt,
         name: "bodies.melt",
         file: "bodies",
         needed: |f| f.bodies && f.heat,
-        gpu: &[
-            always("body_bond", Work::Particles),
-            always("body_melt", Work::Bodies),
+        dispatches: &[
+            always("body_bond", Work::Particles, |b| b.body_bond()),
+            always("body_melt", Work::Bodies, |b| b.body_melt()),
         ],
-        cpu: |b| b.body_melt(),
     },
 ];
 
@@ -417,7 +442,7 @@ impl Stage {
 pub fn entry_points() -> Vec<(&'static str, &'static str)> {
     STAGES
         .iter()
-        .flat_map(|d| d.gpu.iter().map(move |g| (g.entry, d.file)))
+        .flat_map(|d| d.dispatches.iter().map(move |g| (g.entry, d.file)))
         .collect()
 }
 
@@ -427,13 +452,23 @@ mod tests {
 
     #[test]
     fn every_stage_has_one_row_and_every_entry_point_one_stage() {
-        for s in STEP.iter().chain(PRIME.iter()) {
-            assert_eq!(STAGES.iter().filter(|d| d.stage == *s).count(), 1, "{s:?}");
+        for (k, d) in STAGES.iter().enumerate() {
+            assert!(!STAGES[k + 1..].iter().any(|o| o.stage == d.stage), "{:?}", d.stage);
+            assert!(!STAGES[k + 1..].iter().any(|o| o.name == d.name), "{}", d.name);
         }
         let e = entry_points();
         for (k, (entry, _)) in e.iter().enumerate() {
             assert!(!e[k + 1..].iter().any(|(o, _)| o == entry), "{entry} twice");
         }
-        assert_eq!(e.len(), 34);
+    }
+
+    /// A stage's first dispatch has a CPU twin of its own (an `InPrevious` row
+    /// needs a previous twin), and every stage has at least one dispatch.
+    #[test]
+    fn every_stage_starts_with_a_cpu_twin() {
+        for d in &STAGES {
+            let first = d.dispatches.first().unwrap_or_else(|| panic!("{}", d.name));
+            assert!(matches!(first.cpu, Twin::Run(_)), "{}", d.name);
+        }
     }
 }

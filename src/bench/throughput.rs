@@ -253,7 +253,7 @@ fn pass_costs(
     let backend = probe.describe();
     let present: Vec<Stage> = OPTIONAL
         .into_iter()
-        .filter(|st| probe.pipeline().step.contains(st))
+        .filter(|st| probe.pipeline().step_stages().contains(st))
         .collect();
     drop(probe);
     let mut costs = Vec::new();

@@ -132,7 +132,47 @@ pub struct Model {
     pub bodies: Vec<BodySpec>,
     /// F22 (39)–(40) contact between bodies and with walls (scenes with bodies).
     pub contact: Option<Contact>,
+    /// `[heat]`: the energy equation's time integration (heat scenes).
+    pub heat: HeatIntegration,
     pub limits: DtLimits,
+}
+
+/// `[heat]`, validated: Euler, or R18's implicit midpoint with its fixed-point
+/// iteration's tolerance and cap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeatIntegration {
+    pub integrator: crate::scene::HeatIntegrator,
+    pub tolerance: f64,
+    pub max_iterations: u32,
+}
+
+/// The most fixed-point iterations a step may record (each is a conduction
+/// sweep; the GPU records all of them whether or not they run).
+pub const MAX_HEAT_ITERATIONS: u32 = 64;
+
+fn heat_integration(cx: &Ctx, scene: &SceneFile, thermal: bool) -> Result<HeatIntegration, InputError> {
+    let Some(h) = scene.heat else {
+        return Ok(HeatIntegration {
+            integrator: crate::scene::HeatIntegrator::Euler,
+            tolerance: 0.0,
+            max_iterations: 0,
+        });
+    };
+    if !thermal {
+        return Err(cx.err("heat", "the scene has no conducting phase (no temperature)"));
+    }
+    let tolerance = cx.positive("heat.tolerance", h.tolerance)?;
+    if !(1..=MAX_HEAT_ITERATIONS).contains(&h.max_iterations) {
+        return Err(cx.err(
+            "heat.max_iterations",
+            format!("must be 1 to {MAX_HEAT_ITERATIONS} (got {})", h.max_iterations),
+        ));
+    }
+    Ok(HeatIntegration {
+        integrator: h.integrator,
+        tolerance,
+        max_iterations: h.max_iterations,
+    })
 }
 
 pub const MAX_PHASES: usize = 8;
@@ -461,6 +501,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
+    let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
@@ -527,6 +568,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         powder,
         bodies,
         contact,
+        heat,
         limits,
     })
 }

@@ -14,7 +14,9 @@
 //!   k_ij = 4 k_i k_j/(k_i + k_j) between conducting particles, 2 k_i against a
 //!   Dirichlet wall (J22 (25)); adiabatic walls and free surfaces add nothing.
 //!   ∇_iW·r_ij = r dW/dr. A laser source (heat.w, left by the laser pass) adds to
-//!   the rate, surface losses (evaporation, radiation; `surface_loss`) subtract. Explicit Euler: h_i += Δt dh_i/dt (J22 (21)). V_j = m_j/ρ_j with
+//!   the rate, surface losses (evaporation, radiation; `surface_loss`) subtract.
+//!   Explicit Euler: h_i += Δt dh_i/dt (J22 (21)); or the implicit midpoint rule
+//!   (R18 Algorithm 3.1, `begin` and the iteration below). V_j = m_j/ρ_j with
 //!   summation density for fluids and ρ0 for solids and walls, which do not
 //!   compress. Each pair's flux is antisymmetric, so the total enthalpy Σ m h
 //!   changes only through Dirichlet walls and the laser (up to rounding).
@@ -27,7 +29,8 @@ use crate::params::{
     Params, FLAG_BODIES, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
-use crate::state::{State, BODY_SOLIDIFIED};
+use crate::backend::SolverSlot;
+use crate::state::{Solver, State, BODY_SOLIDIFIED};
 use rayon::prelude::*;
 
 /// Density a particle's volume and heat capacity use: summation density for
@@ -74,59 +77,65 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
     }
 }
 
-pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
-    wall_temperature(pr, st, grid);
-    let dt = st.sim.dt;
+/// dh_i/dt of conducting particle i at the temperatures in heat.y (and the
+/// liquid fractions in heat.z): conduction, the laser's source (W/kg), viscous
+/// heating, minus the surface losses.
+#[inline(always)]
+fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) -> f32 {
+    let (pos, rho, mass, phase, heat) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let eta2 = pr.kernel.eta2;
-    // The laser pass left its source (W/kg) in heat.w.
+    let ph_i = phase[i];
+    let k_i = conductivity(pr, ph_i, heat[i][2]);
+    let t_i = heat[i][1];
+    let mut sum = 0.0f32;
+    for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
+        if r2 <= 0.0 {
+            return;
+        }
+        let ph_j = phase[j];
+        let k_ij = if pr.conducts(ph_j) {
+            let k_j = conductivity(pr, ph_j, heat[j][2]);
+            // Ordered operands: i and j compute the same bits, so the
+            // pair's fluxes cancel exactly in the total enthalpy.
+            4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
+        } else if pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0 {
+            2.0 * k_i
+        } else {
+            return;
+        };
+        let r = r2.sqrt();
+        let f = kernel::dw(pr, r) * r / (r2 + eta2);
+        let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
+        sum += v_j * k_ij * (t_i - heat[j][1]) * f;
+    });
+    let mut source = laser_source;
+    if pr.flag(crate::params::FLAG_VISCOUS_HEATING) {
+        source += st.acc[i][3];
+    }
+    let loss = if pr.flag(FLAG_INTERFACE) {
+        surface_loss(pr, ph_i, t_i, st.surface[i][3])
+    } else {
+        0.0
+    };
+    source - loss + sum / heat_density(pr, rho, ph_i, i)
+}
+
+/// `conduct`: explicit Euler, h_i += Δt dh_i/dt (J22 (21)); the laser pass left
+/// its source (W/kg) in heat.w.
+pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
+    let dt = st.sim.dt;
     let laser_on = pr.laser.model != 0;
-    let surface_on = pr.flag(FLAG_INTERFACE);
-    let viscous_heating = pr.flag(crate::params::FLAG_VISCOUS_HEATING);
-    let acc = &st.acc;
-    let surf = &st.surface;
-    let (pos, rho, mass, phase, heat_in) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
-    let rates: Vec<f32> = (0..st.active())
+    let s: &State = st;
+    let rates: Vec<f32> = (0..s.active())
         .into_par_iter()
         .map(|i| {
-            let ph_i = phase[i];
-            if !pr.conducts(ph_i) {
+            if !pr.conducts(s.phase[i]) {
                 return 0.0;
             }
-            let k_i = conductivity(pr, ph_i, heat_in[i][2]);
-            let t_i = heat_in[i][1];
-            let mut sum = 0.0f32;
-            for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
-                if r2 <= 0.0 {
-                    return;
-                }
-                let ph_j = phase[j];
-                let k_ij = if pr.conducts(ph_j) {
-                    let k_j = conductivity(pr, ph_j, heat_in[j][2]);
-                    // Ordered operands: i and j compute the same bits, so the
-                    // pair's fluxes cancel exactly in the total enthalpy.
-                    4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
-                } else if pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0 {
-                    2.0 * k_i
-                } else {
-                    return;
-                };
-                let r = r2.sqrt();
-                let f = kernel::dw(pr, r) * r / (r2 + eta2);
-                let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
-                sum += v_j * k_ij * (t_i - heat_in[j][1]) * f;
-            });
-            let mut source = if laser_on { heat_in[i][3] } else { 0.0 };
-            if viscous_heating {
-                source += acc[i][3];
-            }
-            let loss = if surface_on {
-                surface_loss(pr, ph_i, t_i, surf[i][3])
-            } else {
-                0.0
-            };
-            source - loss + sum / heat_density(pr, rho, ph_i, i)
+            rate(pr, s, grid, i, if laser_on { s.heat[i][3] } else { 0.0 })
         })
         .collect();
+    let phase = &st.phase;
     st.heat[..rates.len()]
         .par_iter_mut()
         .zip(rates)
@@ -137,6 +146,114 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 hv[3] = rate;
             }
         });
+}
+
+/// The implicit midpoint rule (R18 Algorithm 3.1),
+///   h^{n+1} = h^n + Δt ḣ(T((h^n + h^{n+1})/2)),
+/// solved by fixed-point iteration h^{k+1} = h^n + Δt ḣ_k, ḣ_k = ḣ(T((h^n + h^k)/2)),
+/// from h^0 = h^n (whose first iterate is the explicit Euler step) until
+/// max|ḣ_k − ḣ_{k−1}| ≤ tol · max|ḣ_k| over conducting particles, i.e.
+/// max|h^{k+1} − h^k| ≤ tol · max|h^{k+1} − h^n| without the rounding of h^n
+/// (ḣ_{−1} = 0, so the first iteration's residual is 1). Conduction, surface losses and
+/// the Dirichlet mirrors follow the midpoint temperature; the laser source and
+/// viscous heating are those of the step. T and f_l of h^{n+1} and the phase
+/// switches follow in `temperature` after the loop, as for Euler.
+///
+/// `heat_begin`: heat_start = (h^n, the laser source, 0, 0), the rate in heat.w
+/// zeroed (ḣ_{−1}) and the solver reset.
+pub fn begin(pr: &Params, st: &mut State) {
+    let n = st.active();
+    let laser_on = pr.laser.model != 0;
+    let phase = &st.phase;
+    st.heat_start[..n]
+        .par_iter_mut()
+        .zip(st.heat[..n].par_iter_mut())
+        .enumerate()
+        .for_each(|(i, (hs, hv))| {
+            *hs = if pr.conducts(phase[i]) {
+                let h = [hv[0], if laser_on { hv[3] } else { 0.0 }, 0.0, 0.0];
+                hv[3] = 0.0;
+                h
+            } else {
+                [0.0; 4]
+            };
+        });
+    st.solvers[SolverSlot::Heat as usize] = Solver::default();
+}
+
+/// The heat solver's flag: the loop's twins return at once once it is set.
+pub fn heat_converged(st: &State) -> bool {
+    st.solvers[SolverSlot::Heat as usize].converged != 0
+}
+
+/// `iterate_temperature`: T and f_l at the midpoint enthalpy (h^n + h^k)/2.
+pub fn iterate_temperature(pr: &Params, st: &mut State) {
+    if heat_converged(st) {
+        return;
+    }
+    let n = st.active();
+    let (start, phase) = (&st.heat_start, &st.phase);
+    st.heat[..n]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(i, hv)| {
+            if pr.conducts(phase[i]) {
+                let (t, fl) = temperature_of(pr, phase[i], (start[i][0] + hv[0]) * 0.5);
+                hv[1] = t;
+                hv[2] = fl;
+            }
+        });
+}
+
+/// `iterate_conduct`: h^{k+1} = h^n + Δt ḣ_k, and |ḣ_k − ḣ_{k−1}| and |ḣ_k| into
+/// heat_start.zw (rates, not enthalpies: lavapipe folds (a + b) − a to b).
+pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
+    if heat_converged(st) {
+        return;
+    }
+    let dt = st.sim.dt;
+    let s: &State = st;
+    let rates: Vec<f32> = (0..s.active())
+        .into_par_iter()
+        .map(|i| {
+            if !pr.conducts(s.phase[i]) {
+                return 0.0;
+            }
+            rate(pr, s, grid, i, s.heat_start[i][1])
+        })
+        .collect();
+    let phase = &st.phase;
+    st.heat[..rates.len()]
+        .par_iter_mut()
+        .zip(st.heat_start[..rates.len()].par_iter_mut())
+        .zip(rates)
+        .enumerate()
+        .for_each(|(i, ((hv, hs), rate))| {
+            if pr.conducts(phase[i]) {
+                hs[2] = (rate - hv[3]).abs();
+                hs[3] = rate.abs();
+                hv[0] = hs[0] + dt * rate;
+                hv[3] = rate;
+            }
+        });
+}
+
+/// `heat_residual` + `heat_residual_final`: max|ḣ_k − ḣ_{k−1}| / max|ḣ_k|
+/// over conducting particles (max is exact and order-free: the GPU's tree gives
+/// the same bits), one more iteration, and the flag.
+pub fn residual(pr: &Params, st: &mut State) {
+    if heat_converged(st) {
+        return;
+    }
+    let (dmax, smax) = (0..st.active())
+        .into_par_iter()
+        .filter(|&i| pr.conducts(st.phase[i]))
+        .map(|i| (st.heat_start[i][2], st.heat_start[i][3]))
+        .reduce(|| (0.0f32, 0.0f32), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    let s = &mut st.solvers[SolverSlot::Heat as usize];
+    s.iterations += 1;
+    s.residual = if smax > 0.0 { dmax / smax } else { 0.0 };
+    s.converged = (s.residual <= pr.solve.heat_tolerance) as u32;
 }
 
 /// Heat lost through the free surface per unit mass (W/kg): evaporation F22 (18)

@@ -23,7 +23,7 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, FLAG_GAS_INTERFACE, FLAG_WETTING, KIND_GAS};
+use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -32,11 +32,10 @@ pub fn condensed(pr: &Params, phase: u32) -> bool {
     pr.phases[phase as usize].kind != KIND_GAS
 }
 
-pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
-    if pr.flag(FLAG_GAS_INTERFACE) {
-        return gas_interface(pr, st, grid);
-    }
-    // Sums of the particles still in the simulation; the Shepard sums follow all n.
+/// `shepard` (free-surface form): Γ_i = Σ_j V_j W_ij over condensed neighbours
+/// (V = m/ρ0), into surface[n + i].x (y, z zeroed) for the particles still in the
+/// simulation.
+pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
@@ -55,6 +54,21 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
             g
         })
         .collect();
+    for (s, g) in st.surface[n..n + active].iter_mut().zip(gamma) {
+        *s = [g, 0.0, 0.0, 0.0];
+    }
+}
+
+/// `normals`: F22's gas-interface form, or the free-surface form R18 (3.25)–(3.27)
+/// from the Shepard sums `shepard` left in surface[n + j].x.
+pub fn normals(pr: &Params, st: &mut State, grid: &CellTable) {
+    if pr.flag(FLAG_GAS_INTERFACE) {
+        return gas_interface(pr, st, grid);
+    }
+    let (n, active) = (st.len(), st.active());
+    let (pos, mass, phase, surface) = (&st.pos, &st.mass, &st.phase, &st.surface);
+    let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
+    let gamma = |j: usize| surface[n + j][0];
     let inv_h = pr.kernel.inv_h;
     let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
@@ -68,7 +82,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                     return;
                 }
                 let r = r2.sqrt();
-                let f = vol(j) * (1.0 / gamma[i] + 1.0 / gamma[j]) * kernel::dw(pr, r) / r;
+                let f = vol(j) * (1.0 / gamma(i) + 1.0 / gamma(j)) * kernel::dw(pr, r) / r;
                 for a in 0..3 {
                     g[a] += f * d[a];
                 }
@@ -83,9 +97,25 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
         })
         .collect();
     st.surface[..active].copy_from_slice(&normals);
-    for (s, g) in st.surface[n..n + active].iter_mut().zip(gamma) {
-        *s = [g, 0.0, 0.0, 0.0];
-    }
+}
+
+/// `wetting`: the prescribed normal near walls and solids, F22 (27)–(29), on the
+/// tension pair's particles with a normal.
+pub fn wetting(pr: &Params, st: &mut State, grid: &CellTable) {
+    let n = st.active();
+    let s: &State = st;
+    let wetted: Vec<[f32; 4]> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let ph = s.phase[i];
+            let n_i = s.surface[i];
+            if n_i[3] == 0.0 || (ph != pr.tension.liquid && ph != pr.tension.gas) {
+                return n_i;
+            }
+            wet(pr, s, grid, i, n_i)
+        })
+        .collect();
+    st.surface[..n].copy_from_slice(&wetted);
 }
 
 /// Density of a particle for volumes: summation density for fluids, ρ0 otherwise.
@@ -224,19 +254,4 @@ fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
         })
         .collect();
     st.surface[..n].copy_from_slice(&normals);
-    if pr.flag(FLAG_WETTING) {
-        let s: &State = st;
-        let wetted: Vec<[f32; 4]> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let ph = s.phase[i];
-                let n_i = s.surface[i];
-                if n_i[3] == 0.0 || (ph != pr.tension.liquid && ph != pr.tension.gas) {
-                    return n_i;
-                }
-                wet(pr, s, grid, i, n_i)
-            })
-            .collect();
-        st.surface[..n].copy_from_slice(&wetted);
-    }
 }

@@ -15,7 +15,7 @@ mod terms;
 mod timestep;
 mod wall;
 
-use super::{Backend, DeviceLost, Pipeline, Stage};
+use super::{Backend, DeviceLost, Node, Pipeline, Stage, Twin};
 use crate::params::Params;
 use crate::state::{Sim, State};
 use std::time::Instant;
@@ -65,7 +65,8 @@ impl CpuBackend {
     }
 }
 
-/// The CPU twin of each stage, named as in the pass table (backend/passes.rs).
+/// The CPU twin of each dispatch, named as in the pass table (backend/passes.rs),
+/// which says when each runs.
 impl CpuBackend {
     pub(crate) fn kick_drift(&mut self) {
         integrate::kick_drift(&self.params, &mut self.st)
@@ -79,36 +80,64 @@ impl CpuBackend {
     pub(crate) fn wall(&mut self) {
         wall::run(&self.params, &mut self.st, &self.grid)
     }
-    pub(crate) fn interface(&mut self) {
-        interface::run(&self.params, &mut self.st, &self.grid)
+    pub(crate) fn shepard(&mut self) {
+        interface::shepard(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn normals(&mut self) {
+        interface::normals(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn wetting(&mut self) {
+        interface::wetting(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn forces(&mut self) {
         forces::run(&self.params, &mut self.st, &self.grid, &self.list)
     }
-    pub(crate) fn surface_forces(&mut self) {
-        let f = self.pipeline.features;
-        if f.free_surface_tension {
-            surface_forces::tension_curvature(&self.params, &mut self.st, &self.grid);
-            surface_forces::tension_smooth(&self.params, &mut self.st, &self.grid);
-        } else if f.surface_tension {
-            surface_forces::surface_tension(&self.params, &mut self.st, &self.grid);
-        }
-        if f.recoil {
-            surface_forces::recoil(&self.params, &mut self.st);
-        }
+    pub(crate) fn surface_tension(&mut self) {
+        surface_forces::surface_tension(&self.params, &mut self.st, &self.grid)
     }
-    pub(crate) fn laser(&mut self) {
-        let pr = &self.params;
-        if self.pipeline.features.laser_surface {
-            laser::surface(pr, &mut self.st);
-        } else {
-            laser::bins(pr, &self.st, &self.grid, &mut self.laser_bins);
-            laser::columns(pr, self.st.sim.time, &mut self.laser_bins);
-            laser::deposit(pr, &mut self.st, &self.laser_bins);
-        }
+    pub(crate) fn tension_curvature(&mut self) {
+        surface_forces::tension_curvature(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn tension_smooth(&mut self) {
+        surface_forces::tension_smooth(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn recoil(&mut self) {
+        surface_forces::recoil(&self.params, &mut self.st)
+    }
+    pub(crate) fn laser_surface(&mut self) {
+        laser::surface(&self.params, &mut self.st)
+    }
+    pub(crate) fn laser_bins(&mut self) {
+        laser::bins(&self.params, &self.st, &self.grid, &mut self.laser_bins)
+    }
+    pub(crate) fn laser_columns(&mut self) {
+        laser::columns(&self.params, self.st.sim.time, &mut self.laser_bins)
+    }
+    pub(crate) fn laser_deposit(&mut self) {
+        laser::deposit(&self.params, &mut self.st, &self.laser_bins)
+    }
+    pub(crate) fn wall_temperature(&mut self) {
+        heat::wall_temperature(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn conduct(&mut self) {
         heat::conduct(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn heat_begin(&mut self) {
+        heat::begin(&self.params, &mut self.st)
+    }
+    pub(crate) fn iterate_temperature(&mut self) {
+        heat::iterate_temperature(&self.params, &mut self.st)
+    }
+    pub(crate) fn iterate_wall_temperature(&mut self) {
+        if !heat::heat_converged(&self.st) {
+            heat::wall_temperature(&self.params, &mut self.st, &self.grid)
+        }
+    }
+    pub(crate) fn iterate_conduct(&mut self) {
+        heat::iterate_conduct(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn heat_residual(&mut self) {
+        heat::residual(&self.params, &mut self.st)
     }
     pub(crate) fn temperature(&mut self) {
         heat::temperature(&self.params, &mut self.st)
@@ -120,16 +149,22 @@ impl CpuBackend {
         timestep::run(&self.params, &mut self.st)
     }
     pub(crate) fn body_drift(&mut self) {
-        bodies::drift(&self.params, &mut self.st);
-        bodies::place(&mut self.st);
+        bodies::drift(&self.params, &mut self.st)
+    }
+    pub(crate) fn body_place(&mut self) {
+        bodies::place(&mut self.st)
     }
     pub(crate) fn body_forces(&mut self) {
-        bodies::forces(&self.params, &mut self.st, &self.grid);
-        bodies::sum(&mut self.st);
+        bodies::forces(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn body_sum(&mut self) {
+        bodies::sum(&mut self.st)
+    }
+    pub(crate) fn body_bond(&mut self) {
+        bodies::bond(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn body_melt(&mut self) {
-        bodies::bond(&self.params, &mut self.st, &self.grid);
-        bodies::melt(&self.params, &mut self.st);
+        bodies::melt(&self.params, &mut self.st)
     }
     pub(crate) fn body_kick(&mut self) {
         bodies::kick(&self.params, &mut self.st)
@@ -147,16 +182,39 @@ impl Backend for CpuBackend {
         &self.pipeline
     }
     fn skip_stage(&mut self, stage: Stage) {
-        self.pipeline.step.retain(|&s| s != stage);
+        self.pipeline.skip(stage);
     }
     fn run_stage(&mut self, stage: Stage) {
         let t0 = Instant::now();
-        (stage.def().cpu)(self);
+        let features = self.pipeline.features;
+        for d in stage.def().dispatches.iter().filter(|d| (d.when)(&features)) {
+            if let Twin::Run(twin) = d.cpu {
+                twin(self);
+            }
+        }
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         let name = stage.name();
         match self.times.iter_mut().find(|(n, _)| *n == name) {
             Some(e) => e.1 += ms,
             None => self.times.push((name, ms)),
+        }
+    }
+    /// A repeat stops once its solver's flag is set: the GPU's remaining
+    /// iterations return at once, so the state is the same.
+    fn run_node(&mut self, node: &Node) {
+        match node {
+            Node::Stage(s) => self.run_stage(*s),
+            Node::Repeat(r) => {
+                self.run_stage(r.begin);
+                for _ in 0..r.max_iterations {
+                    if self.st.solvers[r.solver as usize].converged != 0 {
+                        break;
+                    }
+                    for &s in &r.stages {
+                        self.run_stage(s);
+                    }
+                }
+            }
         }
     }
     fn read_state(&mut self) -> Result<State, DeviceLost> {

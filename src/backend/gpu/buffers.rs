@@ -1,13 +1,15 @@
-//! Device buffers and the bind groups over them: one per pass file, the same
-//! buffers at the same bindings, each pass's read-only ones marked read-only (the
-//! pass's `// writes:` line, backend::gpu::shaders). The per-particle fields
-//! come from the field registry (crate::fields); the rest is the cell table, the
-//! sort keys, per-step scalars and scene-specific tables. `BINDINGS` names the
-//! buffer at each binding of shaders/lib/bindings.wgsl (tests/fields.rs reads that
-//! file through naga and holds the two to each other).
+//! Device buffers and the bind groups over them. Every buffer a pass can bind is
+//! a row of a registry: the per-particle fields and their reorder scratch
+//! (crate::fields::FIELDS), the state's tables (crate::fields::TABLES) and the
+//! device-only buffers below (`DEVICE_BUFFERS`). A pass binds only the buffers
+//! its WGSL header names (`// reads:`, `// writes:`, and its libraries'
+//! `// reads:`), numbered in registry order from 1 (0 is the parameter block);
+//! its composed WGSL declares exactly those (backend::gpu::shaders), read-only
+//! unless written, and its bind group layout says the same. tests/fields.rs holds
+//! each pass's naga-reflected bindings to its header.
 
 use super::sort::{stage_uniforms, SortStep};
-use crate::fields::{Held, FIELDS};
+use crate::fields::{Held, FIELDS, TABLES};
 use crate::params::{Params, LASER_BEER_LAMBERT};
 use crate::state::{Sim, State};
 use wgpu::util::DeviceExt;
@@ -15,50 +17,111 @@ use wgpu::util::DeviceExt;
 /// Workgroups of the max-speed reduction (timestep.wgsl).
 pub const REDUCE_WG: u32 = 256;
 
-/// Group 0, binding by binding, grouped by concern.
-pub const BINDINGS: [&str; 32] = [
-    // The parameter block.
-    "P",
-    // Particle fields (crate::fields).
-    "pos",
-    "vel",
-    "acc",
-    "acc_b",
-    "rho",
-    "press",
-    "mass",
-    "phase",
-    "id",
-    // Neighbour search: sort keys and the cell table.
-    "keys",
-    "cell_start",
-    "cell_end",
-    // Reorder scratch of the sorted fields.
-    "s_pos",
-    "s_vel",
-    "s_acc",
-    "s_acc_b",
-    "s_mass",
-    "s_phase",
-    "s_id",
-    // Per-step scalars and the reduction's partial maxima.
-    "sim",
-    "partials",
-    // Heat scenes: the heat field and its scratch.
-    "heat",
-    "s_heat",
-    // Laser bins; interface normals; cells holding fluid (wall pass).
-    "bins",
-    "surface",
-    "cell_fluid",
-    // Rigid bodies: body and offset by particle id, the body table, the member
-    // lists and the id -> index slots.
-    "body",
-    "body_offset",
-    "bodies",
-    "members",
-    "slots",
+/// A buffer that lives on the device only: name (its WGSL binding) and WGSL type.
+pub struct DeviceBuffer {
+    pub name: &'static str,
+    pub wgsl: &'static str,
+}
+
+/// The device-only buffers, in binding order after the fields and tables.
+pub const DEVICE_BUFFERS: [DeviceBuffer; 8] = [
+    // Neighbour search: sort keys (cell, index), the cell table.
+    DeviceBuffer { name: "keys", wgsl: "array<vec2<u32>>" },
+    DeviceBuffer { name: "cell_start", wgsl: "array<u32>" },
+    DeviceBuffer { name: "cell_end", wgsl: "array<u32>" },
+    // 1 where a cell holds a fluid particle (set in cell_bounds; the wall pass
+    // skips wall particles with no such cell around them). Order-free integer
+    // atomics.
+    DeviceBuffer { name: "cell_fluid", wgsl: "array<atomic<u32>>" },
+    // Per-step scalars (Δt, time, step, the binding limit, ...).
+    DeviceBuffer { name: "sim", wgsl: "Sim" },
+    // A reduction's per-workgroup partial maxima.
+    DeviceBuffer { name: "partials", wgsl: "array<vec2<f32>>" },
+    // Laser scenes: per bin (Σ w V, absorbed power).
+    DeviceBuffer { name: "bins", wgsl: "array<vec2<f32>>" },
+    // Rigid bodies: each particle id's current index (body_slots).
+    DeviceBuffer { name: "slots", wgsl: "array<u32>" },
 ];
+
+/// One bindable buffer: its name and WGSL declaration type.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bindable {
+    pub name: &'static str,
+    pub wgsl: String,
+}
+
+fn field_wgsl(components: usize, is_float: bool) -> String {
+    let scalar = if is_float { "f32" } else { "u32" };
+    match components {
+        1 => format!("array<{scalar}>"),
+        c => format!("array<vec{c}<{scalar}>>"),
+    }
+}
+
+/// Every storage buffer a pass can bind, in binding order: the fields, their
+/// scratch, the tables, the device-only buffers.
+pub fn bindable() -> Vec<Bindable> {
+    let mut out: Vec<Bindable> = FIELDS
+        .iter()
+        .map(|f| Bindable {
+            name: f.binding,
+            wgsl: field_wgsl(f.components, f.is_float),
+        })
+        .collect();
+    out.extend(FIELDS.iter().filter_map(|f| {
+        f.scratch.map(|s| Bindable {
+            name: s,
+            wgsl: field_wgsl(f.components, f.is_float),
+        })
+    }));
+    out.extend(TABLES.iter().map(|t| Bindable {
+        name: t.name,
+        wgsl: format!("array<{}>", t.wgsl),
+    }));
+    out.extend(DEVICE_BUFFERS.iter().map(|d| Bindable {
+        name: d.name,
+        wgsl: d.wgsl.to_string(),
+    }));
+    out
+}
+
+/// One binding of a pass: the buffer, whether the pass writes it, its number.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PassBinding {
+    pub binding: u32,
+    pub name: &'static str,
+    pub wgsl: String,
+    pub writable: bool,
+}
+
+impl PassBinding {
+    /// Atomics stay read_write in WGSL even where the pass only reads them.
+    pub fn read_write(&self) -> bool {
+        self.writable || self.wgsl.contains("atomic<")
+    }
+}
+
+/// A pass's bindings from the names it reads and writes: registry order,
+/// numbered from 1. A name the registry does not know is an error.
+pub fn pass_bindings(reads: &[&str], writes: &[&str]) -> Result<Vec<PassBinding>, String> {
+    let all = bindable();
+    for n in reads.iter().chain(writes) {
+        if !all.iter().any(|b| b.name == *n) {
+            return Err(format!("no buffer named '{n}' (fields, tables, DEVICE_BUFFERS)"));
+        }
+    }
+    Ok(all
+        .into_iter()
+        .filter(|b| reads.contains(&b.name) || writes.contains(&b.name))
+        .enumerate()
+        .map(|(k, b)| PassBinding {
+            binding: k as u32 + 1,
+            name: b.name,
+            writable: writes.contains(&b.name),
+            wgsl: b.wgsl,
+        })
+        .collect())
+}
 
 pub fn storage(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
@@ -86,10 +149,9 @@ pub struct Buffers {
     pub sort_stages: wgpu::Buffer,
     /// Laser bins (Σ wV, absorbed power); a 16-byte placeholder without a laser.
     pub bins: wgpu::Buffer,
-    /// Rigid bodies: the body table, the member lists, each id's current index
-    /// (16-byte placeholders without bodies).
-    pub bodies: wgpu::Buffer,
-    pub members: wgpu::Buffer,
+    /// One per `TABLES` row (a placeholder of `min_entries` where the scene lacks it).
+    pub tables: Vec<wgpu::Buffer>,
+    /// Rigid bodies: each id's current index (a placeholder without bodies).
     pub slots: wgpu::Buffer,
 }
 
@@ -118,11 +180,12 @@ impl Buffers {
     pub fn new(
         device: &wgpu::Device,
         params: &Params,
-        n: u32,
+        st: &State,
         n_pad: u32,
         held: Held,
         sort: &[SortStep],
     ) -> Buffers {
+        let n = st.len() as u32;
         let n_cells = params.sizes.n_cells as u64;
         let size = |f: &crate::fields::FieldDef| {
             if held.holds(f.holder) {
@@ -157,19 +220,14 @@ impl Buffers {
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
             bins: storage(device, "laser bins", laser_bin_count(params) as u64 * 8),
-            // At least one entry: the wall pass declares the table, and a binding
-            // must hold one element of it (128 bytes) even where no body exists.
-            bodies: storage(
-                device,
-                "bodies",
-                params.bodies.n_bodies.max(1) as u64
-                    * std::mem::size_of::<crate::state::Body>() as u64,
-            ),
-            members: storage(
-                device,
-                "members",
-                if held.bodies { n as u64 * 4 } else { 0 },
-            ),
+            tables: TABLES
+                .iter()
+                .map(|t| {
+                    let entries = if held.holds(t.holder) { t.entries(st) } else { 0 };
+                    let bytes = entries.max(t.min_entries) as u64 * t.components as u64 * 4;
+                    storage(device, t.name, bytes)
+                })
+                .collect(),
             slots: storage(device, "slots", if held.bodies { n as u64 * 4 } else { 0 }),
         }
     }
@@ -182,8 +240,10 @@ impl Buffers {
         if let Some(k) = FIELDS.iter().position(|f| f.scratch == Some(name)) {
             return self.scratch[k].as_ref().expect("scratch allocated");
         }
+        if let Some(k) = TABLES.iter().position(|t| t.name == name) {
+            return &self.tables[k];
+        }
         match name {
-            "P" => &self.params,
             "keys" => &self.keys,
             "cell_start" => &self.cell_start,
             "cell_end" => &self.cell_end,
@@ -191,8 +251,6 @@ impl Buffers {
             "sim" => &self.sim,
             "partials" => &self.partials,
             "bins" => &self.bins,
-            "bodies" => &self.bodies,
-            "members" => &self.members,
             "slots" => &self.slots,
             other => panic!("no buffer for binding {other}"),
         }
@@ -206,9 +264,11 @@ impl Buffers {
                 queue.write_buffer(buf, 0, bytemuck::cast_slice(words));
             }
         }
-        if held.bodies {
-            queue.write_buffer(&self.bodies, 0, bytemuck::cast_slice(&st.bodies));
-            queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&st.members));
+        for (t, buf) in TABLES.iter().zip(&self.tables) {
+            let words = (t.words)(st);
+            if held.holds(t.holder) && !words.is_empty() {
+                queue.write_buffer(buf, 0, bytemuck::cast_slice(words));
+            }
         }
         queue.write_buffer(&self.sim, 0, bytemuck::bytes_of(&st.sim));
         queue.submit([]);
@@ -225,29 +285,28 @@ impl Buffers {
     }
 }
 
-/// A pass's layout of group 0: the parameter block, then every storage buffer,
-/// read-only where the pass only reads it (shaders::read_only_bindings).
-pub fn pass_layout(device: &wgpu::Device, pass: &str, read_only: &[&str]) -> wgpu::BindGroupLayout {
-    let entries: Vec<wgpu::BindGroupLayoutEntry> = BINDINGS
-        .iter()
-        .enumerate()
-        .map(|(b, name)| wgpu::BindGroupLayoutEntry {
-            binding: b as u32,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: if b == 0 {
-                    wgpu::BufferBindingType::Uniform
-                } else {
-                    wgpu::BufferBindingType::Storage {
-                        read_only: read_only.contains(name),
-                    }
-                },
-                has_dynamic_offset: false,
-                min_binding_size: None,
+/// A pass's layout of group 0: the parameter block, then its own bindings,
+/// read-only where the pass only reads them.
+pub fn pass_layout(device: &wgpu::Device, pass: &str, bindings: &[PassBinding]) -> wgpu::BindGroupLayout {
+    let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let mut entries = vec![entry(0, wgpu::BufferBindingType::Uniform)];
+    entries.extend(bindings.iter().map(|b| {
+        entry(
+            b.binding,
+            wgpu::BufferBindingType::Storage {
+                read_only: !b.read_write(),
             },
-            count: None,
-        })
-        .collect();
+        )
+    }));
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(pass),
         entries: &entries,
@@ -274,16 +333,17 @@ pub fn sort_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 pub fn main_bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
+    bindings: &[PassBinding],
     b: &Buffers,
 ) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
-        .iter()
-        .enumerate()
-        .map(|(i, name)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: b.by_binding(name).as_entire_binding(),
-        })
-        .collect();
+    let mut entries = vec![wgpu::BindGroupEntry {
+        binding: 0,
+        resource: b.params.as_entire_binding(),
+    }];
+    entries.extend(bindings.iter().map(|p| wgpu::BindGroupEntry {
+        binding: p.binding,
+        resource: b.by_binding(p.name).as_entire_binding(),
+    }));
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("particles"),
         layout,

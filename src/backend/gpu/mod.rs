@@ -12,12 +12,12 @@ mod profiler;
 pub mod shaders;
 mod sort;
 
-pub use buffers::BINDINGS;
+pub use buffers::{bindable, Bindable, PassBinding, DEVICE_BUFFERS};
 pub use context::{AdapterChoice, GpuContext};
-pub use shaders::shader_sources;
+pub use shaders::{pass_bindings, shader_sources};
 
-use super::{Backend, DeviceLost, Pipeline, Stage, Work};
-use crate::fields::{Held, FIELDS};
+use super::{Backend, DeviceLost, Node, Pipeline, Stage, Work};
+use crate::fields::{Held, FIELDS, TABLES};
 use crate::params::Params;
 use crate::state::{Sim, State};
 use buffers::{laser_bin_count, Buffers, REDUCE_WG};
@@ -36,9 +36,10 @@ pub struct GpuBackend {
     held: Held,
     n: u32,
     n_pad: u32,
-    /// Entries of the body member list (rigid-body scenes).
-    n_members: u64,
     sort_steps: Vec<SortStep>,
+    /// Entries of each table (crate::fields::TABLES) the state holds: fixed
+    /// for the run (bodies and members keep their ranges; solver slots).
+    table_entries: Vec<usize>,
     buf: Buffers,
     /// Group 0 per pass file (same buffers, each pass's read-only ones marked).
     binds: HashMap<&'static str, wgpu::BindGroup>,
@@ -53,11 +54,7 @@ impl GpuBackend {
         let n_pad = n.next_power_of_two().max(2);
         let device = &ctx.device;
         let pipeline = Pipeline::for_scene(&params, st);
-        let held = Held {
-            heat: pipeline.features.heat,
-            interface: pipeline.features.interface,
-            bodies: pipeline.features.bodies,
-        };
+        let held = pipeline.held();
         let limit = ctx.limits.max_storage_buffer_binding_size;
         let biggest = buffers::largest_buffer(&params, n, n_pad, held);
         if biggest > limit {
@@ -66,19 +63,27 @@ impl GpuBackend {
             ));
         }
         let stages = sort_stages(n_pad);
-        let buf = Buffers::new(device, &params, n, n_pad, held, &stages);
+        let buf = Buffers::new(device, &params, st, n_pad, held, &stages);
         // A shader the driver rejects is an error of this run, not a panic.
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let layouts: HashMap<&'static str, wgpu::BindGroupLayout> = shaders::PASSES
+        let bindings: HashMap<&'static str, Vec<PassBinding>> = shaders::PASSES
             .iter()
             .map(|(file, src)| {
-                let read_only = shaders::read_only_bindings(src);
-                (*file, buffers::pass_layout(device, file, &read_only))
+                let b = shaders::pass_bindings(src)
+                    .unwrap_or_else(|e| panic!("shaders/{file}.wgsl: {e}"));
+                (*file, b)
             })
+            .collect();
+        let layouts: HashMap<&'static str, wgpu::BindGroupLayout> = bindings
+            .iter()
+            .map(|(file, b)| (*file, buffers::pass_layout(device, file, b)))
             .collect();
         let binds = layouts
             .iter()
-            .map(|(file, layout)| (*file, buffers::main_bind_group(device, layout, &buf)))
+            .map(|(file, layout)| {
+                let group = buffers::main_bind_group(device, layout, &bindings[file], &buf);
+                (*file, group)
+            })
             .collect();
         let sort_layout = buffers::sort_layout(device);
         let sort_bind = buffers::sort_bind_group(device, &sort_layout, &buf);
@@ -91,7 +96,7 @@ impl GpuBackend {
             Profiler::new(
                 device,
                 ctx.queue.get_timestamp_period(),
-                pipeline.step.len(),
+                pipeline.recorded_step().len(),
             )
         });
         let g = GpuBackend {
@@ -101,8 +106,8 @@ impl GpuBackend {
             held,
             n,
             n_pad,
-            n_members: st.members.len() as u64,
             sort_steps: stages,
+            table_entries: TABLES.iter().map(|t| t.entries(st)).collect(),
             buf,
             binds,
             sort_bind,
@@ -177,8 +182,28 @@ impl GpuBackend {
         }
         let features = &self.pipeline.features;
         let mut pass = self.begin_pass(enc, stage, idx);
-        for d in stage.def().gpu.iter().filter(|d| (d.when)(features)) {
+        for d in stage.def().dispatches.iter().filter(|d| (d.when)(features)) {
             self.dispatch(&mut pass, d.entry, d.work);
+        }
+    }
+
+    /// Record one node: a repeat's begin, then every iteration of its stages (a
+    /// finished loop's kernels return at once after reading the solver's flag).
+    /// `idx` is the node's first timestamp slot; returns the next one.
+    fn encode_node(&self, enc: &mut wgpu::CommandEncoder, node: &Node, idx: u32) -> u32 {
+        let mut k = idx;
+        for s in node.recorded() {
+            self.encode_stage(enc, s, k);
+            k += 1;
+        }
+        k
+    }
+
+    /// Record one whole step.
+    fn encode_step(&self, enc: &mut wgpu::CommandEncoder) {
+        let mut idx = 0;
+        for node in &self.pipeline.step {
+            idx = self.encode_node(enc, node, idx);
         }
     }
 
@@ -248,7 +273,7 @@ impl GpuBackend {
     fn collect_profile(&mut self) {
         let Some(p) = &self.profiler else { return };
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        let stages = self.pipeline.step.len();
+        let stages = self.pipeline.recorded_step().len();
         enc.resolve_query_set(&p.queries, 0..2 * stages as u32, &p.resolve, 0);
         self.submit(enc);
         // A failed readback here surfaces at the run's next read_sim.
@@ -256,7 +281,7 @@ impl GpuBackend {
             return;
         };
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
-        let step = self.pipeline.step.clone();
+        let step = self.pipeline.recorded_step();
         if let Some(p) = self.profiler.as_mut() {
             p.record(&step, &ticks);
         }
@@ -283,13 +308,13 @@ impl Backend for GpuBackend {
         &self.pipeline
     }
     fn skip_stage(&mut self, stage: Stage) {
-        self.pipeline.step.retain(|&s| s != stage);
+        self.pipeline.skip(stage);
     }
     fn run_stage(&mut self, stage: Stage) {
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
         let idx = self
             .pipeline
-            .step
+            .recorded_step()
             .iter()
             .position(|s| *s == stage)
             .unwrap_or(0) as u32;
@@ -301,9 +326,7 @@ impl Backend for GpuBackend {
             // One step per submission so each pass's timestamps can be collected.
             for _ in 0..n {
                 let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-                for (k, s) in self.pipeline.step.iter().enumerate() {
-                    self.encode_stage(&mut enc, *s, k as u32);
-                }
+                self.encode_step(&mut enc);
                 self.submit(enc);
                 self.collect_profile();
             }
@@ -315,15 +338,13 @@ impl Backend for GpuBackend {
             let chunk = left.min(32);
             let mut enc = self.ctx.device.create_command_encoder(&Default::default());
             for _ in 0..chunk {
-                for (k, s) in self.pipeline.step.iter().enumerate() {
-                    self.encode_stage(&mut enc, *s, k as u32);
-                }
+                self.encode_step(&mut enc);
             }
             self.submit(enc);
             left -= chunk;
         }
     }
-    /// Every field the scene holds (crate::fields), then the Sim block.
+    /// Every field and table the scene holds (crate::fields), then the Sim block.
     fn read_state(&mut self) -> Result<State, DeviceLost> {
         let mut st = State::default();
         for (f, buf) in FIELDS.iter().zip(&self.buf.fields) {
@@ -332,12 +353,11 @@ impl Backend for GpuBackend {
                 (f.set)(&mut st, &self.read_bytes(buf, bytes)?);
             }
         }
-        if self.held.bodies {
-            let bytes = self.params.bodies.n_bodies as u64
-                * std::mem::size_of::<crate::state::Body>() as u64;
-            st.bodies = bytemuck::pod_collect_to_vec(&self.read_bytes(&self.buf.bodies, bytes)?);
-            let members = self.read_bytes(&self.buf.members, self.n_members * 4)?;
-            st.members = bytemuck::pod_collect_to_vec(&members);
+        for ((t, buf), &entries) in TABLES.iter().zip(&self.buf.tables).zip(&self.table_entries) {
+            if self.held.holds(t.holder) && entries > 0 {
+                let bytes = (entries * t.components * 4) as u64;
+                (t.set)(&mut st, &self.read_bytes(buf, bytes)?);
+            }
         }
         st.sim = self.read_sim()?;
         Ok(st)

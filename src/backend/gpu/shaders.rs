@@ -1,7 +1,9 @@
 //! WGSL composition: each pass file names the library files it uses on its first
-//! line (`// uses: params bindings kernel grid`), and the host prepends those (with
-//! what they use in turn) in one fixed order, then expands the neighbour-walk
-//! template. Plain text, no preprocessor crate: naga_oil does not follow naga 30.
+//! line (`// uses: params kernel grid`), and the host prepends those (with what
+//! they use in turn) in one fixed order, declares the buffers the pass and its
+//! libraries name on their `// reads:` and `// writes:` lines (and only those:
+//! gpu::buffers::pass_bindings), then expands the neighbour-walk template. Plain
+//! text, no preprocessor crate: naga_oil does not follow naga 30.
 //!
 //! The neighbour walk is written once, here. A pass writes
 //!
@@ -17,17 +19,14 @@
 //! ones that were measured on hardware. The Rust twin is
 //! `backend::cpu::neighbors::for_each_neighbor`: same cells, same order.
 
+use super::buffers::{pass_bindings as pass_bindings_of, PassBinding};
 use crate::backend::entry_points;
 use crate::params::Params;
 use std::collections::HashMap;
 
 /// Library files, in the order they are composed (each after what it uses).
-const LIBS: [(&str, &str); 9] = [
+const LIBS: [(&str, &str); 8] = [
     ("params", include_str!("../../../shaders/lib/params.wgsl")),
-    (
-        "bindings",
-        include_str!("../../../shaders/lib/bindings.wgsl"),
-    ),
     ("consts", include_str!("../../../shaders/lib/consts.wgsl")),
     ("math", include_str!("../../../shaders/lib/math.wgsl")),
     ("kernel", include_str!("../../../shaders/lib/kernel.wgsl")),
@@ -66,61 +65,47 @@ fn uses(src: &str) -> Vec<&str> {
         .unwrap_or_default()
 }
 
-/// The storage buffers a pass writes, from its `// writes:` line (None: no such
-/// line, every buffer stays read_write).
-fn writes(src: &str) -> Option<Vec<&str>> {
+/// The names on a source's `// {key}:` line among its first lines (none without one).
+fn header<'a>(src: &'a str, key: &str) -> Vec<&'a str> {
+    let prefix = format!("// {key}:");
     src.lines()
         .take(4)
-        .find_map(|l| l.strip_prefix("// writes:"))
+        .find_map(|l| l.strip_prefix(prefix.as_str()))
         .map(|l| l.split_whitespace().collect())
+        .unwrap_or_default()
 }
 
-/// The name of a storage binding a pass may declare `read`: read_write in the
-/// library and not atomic (WGSL keeps atomics read_write).
-fn restrictable(line: &str) -> Option<&str> {
-    if line.contains("atomic<") {
-        return None;
+/// A pass's bindings: what it and its libraries read (`// reads:`) and what it
+/// writes (`// writes:`), in registry order (gpu::buffers::pass_bindings).
+/// A pass with the reorder directive (neighbors.wgsl) also reads every sorted
+/// field and writes its scratch (crate::fields), so a new sorted field needs no
+/// header edit.
+pub fn pass_bindings(pass: &str) -> Result<Vec<PassBinding>, String> {
+    let mut reads = header(pass, "reads");
+    let mut writes = header(pass, "writes");
+    for k in resolve(&uses(pass))? {
+        reads.extend(header(LIBS[k].1, "reads"));
     }
-    line.split("var<storage, read_write> ")
-        .nth(1)?
-        .split(':')
-        .next()
+    if pass.contains(REORDER_DIRECTIVE) {
+        for f in crate::fields::FIELDS.iter().filter(|f| f.scratch.is_some()) {
+            reads.push(f.binding);
+            writes.extend(f.scratch);
+        }
+    }
+    pass_bindings_of(&reads, &writes)
 }
 
-/// The bindings library with the `read_only` buffers declared `read`. naga rejects
-/// a store to a `read` buffer, so a `// writes:` line that misses one fails
-/// tests/shaders.rs.
-fn restrict_access(bindings: &str, read_only: &[&str]) -> String {
-    let mut out = String::with_capacity(bindings.len());
-    for line in bindings.lines() {
-        match restrictable(line) {
-            Some(n) if read_only.contains(&n) => {
-                out.push_str(&line.replacen("read_write", "read", 1))
-            }
-            _ => out.push_str(line),
-        }
-        out.push('\n');
+/// The declarations of a pass's bindings, group 0 (binding 0: the parameter block).
+fn declarations(bindings: &[PassBinding]) -> String {
+    let mut out = String::from("@group(0) @binding(0) var<uniform> P: Params;\n");
+    for b in bindings {
+        let access = if b.read_write() { "read_write" } else { "read" };
+        out.push_str(&format!(
+            "@group(0) @binding({}) var<storage, {access}> {}: {};\n",
+            b.binding, b.name, b.wgsl
+        ));
     }
     out
-}
-
-/// The bindings a pass reads only: every restrictable one its `// writes:` line
-/// does not name (none without such a line). Its composed WGSL declares them
-/// `read` and its bind group layout read-only.
-pub fn read_only_bindings(pass: &str) -> Vec<&'static str> {
-    let Some(w) = writes(pass) else {
-        return Vec::new();
-    };
-    let bindings = LIBS
-        .iter()
-        .find(|(n, _)| *n == "bindings")
-        .expect("bindings")
-        .1;
-    bindings
-        .lines()
-        .filter_map(restrictable)
-        .filter(|n| !w.contains(n))
-        .collect()
 }
 
 /// `wanted` and everything it uses, in LIBS order.
@@ -140,19 +125,17 @@ fn resolve(wanted: &[&str]) -> Result<Vec<usize>, String> {
     Ok((0..LIBS.len()).filter(|&k| need[k]).collect())
 }
 
-/// A pass's complete source: its libraries (storage buffers it does not write
-/// declared `read`), its pair terms (backend::terms), then the pass with every
-/// neighbour walk expanded.
+/// A pass's complete source: its libraries, the declarations of its bindings
+/// (those it does not write `read`), its pair terms (backend::terms), then the
+/// pass with every neighbour walk expanded.
 pub fn compose(name: &str, pass: &str) -> Result<String, String> {
     let mut out = String::new();
-    let read_only = read_only_bindings(pass);
     for k in resolve(&uses(pass))? {
-        match LIBS[k].0 {
-            "bindings" => out.push_str(&restrict_access(LIBS[k].1, &read_only)),
-            _ => out.push_str(LIBS[k].1),
-        }
+        out.push_str(LIBS[k].1);
         out.push('\n');
     }
+    out.push_str(&declarations(&pass_bindings(pass)?));
+    out.push('\n');
     for term in crate::backend::terms::wgsl_for(name) {
         out.push_str(term);
         out.push('\n');
@@ -198,10 +181,14 @@ pub fn expand_reorder(src: &str) -> Result<String, String> {
 pub fn all_libraries() -> String {
     let names: Vec<&str> = LIBS.iter().map(|(n, _)| *n).collect();
     let mut out = String::new();
+    let mut reads = Vec::new();
     for k in resolve(&names).expect("LIBS resolves") {
         out.push_str(LIBS[k].1);
         out.push('\n');
+        reads.extend(header(LIBS[k].1, "reads"));
     }
+    let bindings = pass_bindings_of(&reads, &[]).expect("library reads are buffers");
+    out.push_str(&declarations(&bindings));
     out
 }
 
@@ -386,15 +373,18 @@ mod tests {
     }
 
     #[test]
-    fn buffers_a_pass_does_not_write_are_read_only() {
-        let src = compose("x", "// uses: bindings\n// writes: acc\nfn f() {}\n").unwrap();
+    fn a_pass_declares_only_the_buffers_its_header_names() {
+        let src = compose("x", "// uses: params\n// reads: pos cell_fluid\n// writes: acc\nfn f() {}\n").unwrap();
         assert!(src.contains("var<storage, read_write> acc: array<vec4<f32>>;"));
         assert!(src.contains("var<storage, read> pos: array<vec4<f32>>;"));
-        // Atomics must stay read_write.
+        // Atomics stay read_write.
         assert!(src.contains("var<storage, read_write> cell_fluid: array<atomic<u32>>;"));
-        // Without a writes line nothing changes.
-        let all = compose("x", "// uses: bindings\nfn f() {}\n").unwrap();
-        assert!(all.contains("var<storage, read_write> pos:"));
+        assert!(!src.contains(" vel:"), "not named, not bound");
+        // A library's reads come with it: grid reads the cell table and sim.
+        let grid = compose("x", "// uses: grid\nfn f() {}\n").unwrap();
+        assert!(grid.contains("var<storage, read> cell_start: array<u32>;"));
+        // An unknown buffer is an error, not a silent omission.
+        assert!(compose("x", "// uses: params\n// reads: nonsense\nfn f() {}\n").is_err());
     }
 
     #[test]

@@ -133,6 +133,14 @@ fn body_forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     f[a] = f[a] - s * dj[a];
                 }
             }
+            if (TERM_BARRIER && r < P.flow.barrier_radius) {
+                // F22 (34) as the forces pass applies it to the fluid from a
+                // wall particle: the wall phase's velocity, not the body's.
+                let s = barrier(v_j, P.phases[ph_r].velocity, dj, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] - s * dj[a];
+                }
+            }
         }
         let solid_j = kj != NO_BODY || is_wall(phase[j]);
         if (r2 < P.kernel.support2 && kj != k && r2 < reach2 && r2 > 0.0 && solid_j) {

@@ -605,7 +605,8 @@ fn assert_bit_identical_text(name: &str, text: &str, steps: u64) -> spatter::sta
 /// scene with the grain just below its solidus, so that 10 of its 52 particles
 /// leave in 200 steps): body_melt's departures (material velocity, own force),
 /// the recomputed mass, centre and principal axes (f32 Jacobi) and F22 (37);
-/// with F22 (33)'s solid–fluid viscosity on, whose reaction the body pass sums.
+/// with F22 (33)'s solid–fluid viscosity and F22 (34)'s barrier on, whose
+/// reactions the body pass sums.
 #[test]
 fn melting_grain_2d_200_steps() {
     let st = bit_identical_state(
@@ -613,6 +614,8 @@ fn melting_grain_2d_200_steps() {
         &[
             "phases.grain.temperature=1690.0",
             "simulation.solid_fluid_viscosity={coefficient=1.0, width=300.0}",
+            // The barrier's reaction on the grain too (issue 27).
+            "simulation.barrier={radius_dx=0.9, stiffness=1.0e4, damping=1.0e-2}",
         ],
         200,
     );

@@ -170,8 +170,9 @@ pub fn place(st: &mut State) {
 }
 
 /// `body_forces`: F22 (39)–(40) contact on every body particle, plus F22 (38):
-/// minus the pressure and viscous force the forces pass puts on each fluid
-/// neighbour from this particle (the same pair term, from this side: the pair's
+/// minus every force the forces pass puts on each fluid neighbour from this
+/// particle (backend::terms::reaction_terms: pressure, viscosity, the
+/// solid–fluid viscosity, the barrier) (the same pair term, from this side: the pair's
 /// force is the same bits both ways, so momentum is exchanged exactly per pair);
 /// the total force (N) into acc.
 pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
@@ -181,6 +182,7 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
     let bp = &pr.bodies;
     let reach2 = bp.contact_distance * bp.contact_distance;
     let sf = crate::backend::terms::active(pr, "solid_fluid_viscosity");
+    let br = crate::backend::terms::active(pr, "barrier");
     let heat = &st.heat;
     st.acc[..n].par_iter_mut().enumerate().for_each(|(i, a)| {
         let k = body[id[i] as usize];
@@ -220,6 +222,14 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                     let s = terms::solid_fluid_viscosity(
                         pr, m_j, m_j, rho_j, rho_w, mat.c2, mat.c2, u, dj, r2, dwdr, alpha,
                     );
+                    for c in 0..3 {
+                        f[c] -= s * dj[c];
+                    }
+                }
+                if br && r < pr.flow.barrier_radius {
+                    // F22 (34) as the forces pass applies it to the fluid from a
+                    // wall particle: the wall phase's velocity, not the body's.
+                    let s = terms::barrier(pr, v_j, pr.phase(phase[i]).velocity, dj, r);
                     for c in 0..3 {
                         f[c] -= s * dj[c];
                     }

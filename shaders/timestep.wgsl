@@ -2,7 +2,8 @@
 // reads: vel acc phase
 // writes: sim partials
 // Max |u|² and |a|² over fluid particles by a fixed two-level tree (per-workgroup,
-// then one workgroup over the partials), then the F22 (42) time step.
+// then one workgroup over the partials), then the F22 (42) time step: the
+// smallest of the limits of src/model/limits.rs, in its order.
 // Twin of src/backend/cpu/timestep.rs.
 
 const RWG: u32 = 256u;
@@ -59,37 +60,37 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
     if (speed > 0.0) {
         dt = c_quarter() * h / speed;
     }
-    var which = 0u;
+    var which = DT_ACOUSTIC;
     if (P.time_step.viscous_limit < dt) {
         dt = P.time_step.viscous_limit;
-        which = 1u;
+        which = DT_VISCOUS;
     }
     if (P.time_step.conduction_limit < dt) {
         dt = P.time_step.conduction_limit;
-        which = 4u;
+        which = DT_CONDUCTION;
     }
     if (P.time_step.barrier_limit < dt) {
         dt = P.time_step.barrier_limit;
-        which = 5u;
+        which = DT_BARRIER;
     }
     if (P.time_step.capillary_limit < dt) {
         dt = P.time_step.capillary_limit;
-        which = 6u;
+        which = DT_CAPILLARY;
     }
     if (P.time_step.contact_limit < dt) {
         dt = P.time_step.contact_limit;
-        which = 7u;
+        which = DT_CONTACT;
     }
     if (amax2 > 0.0) {
         let f = c_quarter() * sqrt(h / sqrt(amax2));
         if (f < dt) {
             dt = f;
-            which = 2u;
+            which = DT_FORCE;
         }
     }
     if (P.time_step.fixed_dt > 0.0) {
         dt = P.time_step.fixed_dt;
-        which = 3u;
+        which = DT_FIXED;
     }
     sim.dt = dt;
     sim.dt_limit = which;

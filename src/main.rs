@@ -543,23 +543,22 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             "none (not in this scene)".to_string()
         }
     };
-    // The barrier's, capillary and contact limits only where the scene has them.
-    let mut barrier = String::new();
-    if l.barrier.is_finite() {
-        barrier.push_str(&format!(", barrier {}", limit(l.barrier)));
-    }
-    if l.capillary.is_finite() {
-        barrier.push_str(&format!(", capillary {}", limit(l.capillary)));
-    }
-    if l.contact.is_finite() {
-        barrier.push_str(&format!(", contact {}", limit(l.contact)));
-    }
+    // Every limit of the table the scene has (limits::LIMITS); the first four
+    // always, saying "none" where the physics is absent.
+    use spatter::model::limits::Limit;
+    let always = [Limit::Acoustic, Limit::Viscous, Limit::Force, Limit::Conduction];
+    let listed: Vec<String> = l
+        .rows()
+        .iter()
+        .filter(|(k, v)| always.contains(k) || v.is_finite())
+        .map(|(k, v)| {
+            let name = if *k == Limit::Force { "body force" } else { k.def().name };
+            format!("{name} {}", limit(*v))
+        })
+        .collect();
     println!(
-        "time-step limits: acoustic {}, viscous {}, body force {}, conduction {}{barrier}; binding: {which}",
-        limit(l.acoustic),
-        limit(l.viscous),
-        limit(l.body_force),
-        limit(l.conduction)
+        "time-step limits: {}; binding: {which}",
+        listed.join(", ")
     );
     match m.fixed_dt {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),

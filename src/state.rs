@@ -10,7 +10,7 @@ pub struct Sim {
     pub dt: f32,
     pub time: f32,
     pub step: u32,
-    /// Which F22 (42) limit bound the last step: see `DT_LIMIT_NAMES`.
+    /// Which limit bound the last step: its code in crate::model::limits::LIMITS.
     pub dt_limit: u32,
     pub umax2: f32,
     pub amax2: f32,
@@ -21,16 +21,8 @@ pub struct Sim {
     pub _pad: u32,
 }
 
-pub const DT_LIMIT_NAMES: [&str; 8] = [
-    "acoustic",
-    "viscous",
-    "force",
-    "fixed",
-    "conduction",
-    "barrier",
-    "capillary",
-    "contact",
-];
+/// The limits' short names in code order (crate::model::limits::LIMITS).
+pub const DT_LIMIT_NAMES: [&str; 8] = crate::model::limits::LIMIT_NAMES;
 
 /// Name of the limit code the timestep pass wrote.
 pub fn dt_limit_name(code: u32) -> &'static str {

@@ -231,4 +231,7 @@ fn flag_and_code_constants_match() {
     for (name, v) in expected {
         assert_eq!(value(name), v, "{name}");
     }
+    for d in &spatter::model::limits::LIMITS {
+        assert_eq!(value(d.wgsl), d.limit.code(), "{}", d.wgsl);
+    }
 }

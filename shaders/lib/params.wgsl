@@ -271,4 +271,13 @@ const LASER_SURFACE: u32 = 2u;
 const HEAT_EULER: u32 = 0u;
 const HEAT_IMPLICIT_MIDPOINT: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;
+// Time-step limit codes (sim.dt_limit; src/model/limits.rs).
+const DT_ACOUSTIC: u32 = 0u;
+const DT_VISCOUS: u32 = 1u;
+const DT_FORCE: u32 = 2u;
+const DT_FIXED: u32 = 3u;
+const DT_CONDUCTION: u32 = 4u;
+const DT_BARRIER: u32 = 5u;
+const DT_CAPILLARY: u32 = 6u;
+const DT_CONTACT: u32 = 7u;
 const WG: u32 = 64u;

@@ -4,6 +4,7 @@
 mod bodies;
 mod domain;
 mod laser;
+pub mod limits;
 mod phases;
 mod tension;
 mod thermal;
@@ -51,25 +52,28 @@ pub struct DtLimits {
 }
 
 impl DtLimits {
+    /// The scene's constant limits with their rows of `limits::LIMITS` (∞ where
+    /// the scene lacks the physics; the force limit here is gravity's).
+    pub fn rows(&self) -> [(limits::Limit, f64); 7] {
+        use limits::Limit;
+        [
+            (Limit::Acoustic, self.acoustic),
+            (Limit::Viscous, self.viscous),
+            (Limit::Force, self.body_force),
+            (Limit::Conduction, self.conduction),
+            (Limit::Barrier, self.barrier),
+            (Limit::Capillary, self.capillary),
+            (Limit::Contact, self.contact),
+        ]
+    }
+    /// The smallest limit and its label (the first of equal ones).
     pub fn min(&self) -> (f64, &'static str) {
-        let mut best = (self.acoustic, "acoustic CFL 0.25 h/(c+|u|)");
-        if self.viscous < best.0 {
-            best = (self.viscous, "viscous 0.125 h^2/nu");
-        }
-        if self.body_force < best.0 {
-            best = (self.body_force, "body force 0.25 sqrt(h/|b|)");
-        }
-        if self.conduction < best.0 {
-            best = (self.conduction, "conduction 0.1 rho c_p h^2/k");
-        }
-        if self.barrier < best.0 {
-            best = (self.barrier, "barrier 0.22 sqrt(m/k_b)");
-        }
-        if self.capillary < best.0 {
-            best = (self.capillary, "capillary 0.25 sqrt(rho h^3/(2 pi alpha))");
-        }
-        if self.contact < best.0 {
-            best = (self.contact, "contact 0.22 sqrt(m/k_c)");
+        let rows = self.rows();
+        let mut best = (rows[0].1, rows[0].0.def().label);
+        for (limit, v) in &rows[1..] {
+            if *v < best.0 {
+                best = (*v, limit.def().label);
+            }
         }
         best
     }

@@ -3,6 +3,7 @@
 //! Max over floats is exact and order-free, so this plain fold gives the same bits
 //! as the GPU's two-level tree.
 
+use crate::model::limits::Limit;
 use crate::params::Params;
 use crate::state::State;
 use rayon::prelude::*;
@@ -31,9 +32,8 @@ pub fn run(pr: &Params, st: &mut State) {
     sim.dt_limit = which;
 }
 
-/// The F22 (42) limit that binds: 0 acoustic, 1 viscous, 2 force, 3 fixed,
-/// 4 conduction (0.1 ρ c_p h²/k, issue 4), 5 barrier (0.22 √(m/k_b)),
-/// 6 capillary (0.25 √(ρ h³/(2π α))), 7 contact (0.22 √(m/k_c)). A scene without fluid has no acoustic
+/// The next Δt and the code of the limit that binds (crate::model::limits: the
+/// table's rows, compared in its order). A scene without fluid has no acoustic
 /// limit (c_max = 0, |u| = 0).
 pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
     let h = pr.kernel.h;
@@ -42,37 +42,37 @@ pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
     if speed > 0.0 {
         dt = 0.25 * h / speed;
     }
-    let mut which = 0u32;
+    let mut which = Limit::Acoustic;
     if pr.time_step.viscous_limit < dt {
         dt = pr.time_step.viscous_limit;
-        which = 1;
+        which = Limit::Viscous;
     }
     if pr.time_step.conduction_limit < dt {
         dt = pr.time_step.conduction_limit;
-        which = 4;
+        which = Limit::Conduction;
     }
     if pr.time_step.barrier_limit < dt {
         dt = pr.time_step.barrier_limit;
-        which = 5;
+        which = Limit::Barrier;
     }
     if pr.time_step.capillary_limit < dt {
         dt = pr.time_step.capillary_limit;
-        which = 6;
+        which = Limit::Capillary;
     }
     if pr.time_step.contact_limit < dt {
         dt = pr.time_step.contact_limit;
-        which = 7;
+        which = Limit::Contact;
     }
     if amax2 > 0.0 {
         let f = 0.25 * (h / amax2.sqrt()).sqrt();
         if f < dt {
             dt = f;
-            which = 2;
+            which = Limit::Force;
         }
     }
     if pr.time_step.fixed_dt > 0.0 {
         dt = pr.time_step.fixed_dt;
-        which = 3;
+        which = Limit::Fixed;
     }
-    (dt, which)
+    (dt, which.code())
 }

@@ -117,7 +117,7 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     heat[i] = hv;
 }
 
-// Implicit midpoint (R18 Algorithm 3.1), fixed-point iteration; twin of the
+// Trapezoidal rule (R18 Algorithm 3.1), fixed-point iteration; twin of the
 // functions after `conduct` in src/backend/cpu/heat.rs (equations there).
 // heat_begin: heat_start = (h^n, laser source, 0, 0), heat.w (the rate) 0; the
 // solver reset.
@@ -142,7 +142,7 @@ fn heat_converged() -> bool {
     return solvers[SOLVER_HEAT].converged != 0u;
 }
 
-// T and f_l at the midpoint enthalpy (h^n + h^k) / 2.
+// T and f_l of the iterate h^k.
 @compute @workgroup_size(64)
 fn iterate_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     if (heat_converged()) { return; }
@@ -151,7 +151,7 @@ fn iterate_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     var hv = heat[i];
-    let tf = temperature_of(ph, (heat_start[i].x + hv.x) * c_half());
+    let tf = temperature_of(ph, hv.x);
     hv.y = tf.x;
     hv.z = tf.y;
     heat[i] = hv;
@@ -165,9 +165,10 @@ fn iterate_wall_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @buil
     mirror_temperature(i);
 }
 
-// h^{k+1} = h^n + dt rate_k(T_mid); |rate_k - rate_{k-1}| and |rate_k| to
-// heat_start.zw (the rates, not the enthalpies: (a + b) - a is what lavapipe
-// would fold to b). Neighbours read only T and f_l (.y, .z): in place.
+// rate_k (kept as rate_0 in heat_start.z on the first iteration),
+// h^{k+1} = h^n + dt ((rate_0 + rate_k) / 2), |rate_k - rate_{k-1}| to
+// heat_start.w (rates, not enthalpies: (a + b) - a is what lavapipe would fold
+// to b). Neighbours read only T and f_l (.y, .z): in place.
 @compute @workgroup_size(64)
 fn iterate_conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     if (heat_converged()) { return; }
@@ -177,15 +178,18 @@ fn iterate_conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     var hs = heat_start[i];
     let rate = conduction_rate(i, hs.y);
     var hv = heat[i];
-    hs.z = abs(rate - hv.w);
-    hs.w = abs(rate);
-    hv.x = hs.x + sim.dt * rate;
+    if (solvers[SOLVER_HEAT].iterations == 0u) {
+        hs.z = rate;
+    }
+    hs.w = abs(rate - hv.w);
+    hv.x = hs.x + sim.dt * ((hs.z + rate) * c_half());
     hv.w = rate;
     heat_start[i] = hs;
     heat[i] = hv;
 }
 
-// Max over conducting particles of heat_start.zw by the two-level tree of the
+// Max over conducting particles of |rate_k - rate_{k-1}| (heat_start.w) and
+// |rate_0 + rate_k| by the two-level tree of the
 // time step (timestep.wgsl): per workgroup into partials, then one workgroup.
 const HWG: u32 = 256u;
 var<workgroup> hred: array<vec2<f32>, 256>;
@@ -207,7 +211,8 @@ fn heat_residual(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id)
     let i = g * HWG + t;
     var m = vec2<f32>(0.0, 0.0);
     if (i < active_particles() && conducts(phase[i])) {
-        m = heat_start[i].zw;
+        let hs = heat_start[i];
+        m = vec2<f32>(hs.w, abs(hs.z + heat[i].w));
     }
     hred[t] = m;
     heat_tree_max(t);
@@ -228,11 +233,14 @@ fn heat_residual_final(@builtin(local_invocation_index) t: u32) {
     heat_tree_max(t);
     if (t != 0u) { return; }
     var s = solvers[SOLVER_HEAT];
-    s.iterations = s.iterations + 1u;
-    s.residual = 0.0;
-    if (hred[0].y > 0.0) {
+    if (hred[0].y == 0.0) {
+        s.residual = 0.0;
+    } else if (s.iterations == 0u) {
+        s.residual = c_one();
+    } else {
         s.residual = hred[0].x / hred[0].y;
     }
+    s.iterations = s.iterations + 1u;
     s.converged = select(0u, 1u, s.residual <= P.solve.heat_tolerance);
     solvers[SOLVER_HEAT] = s;
 }

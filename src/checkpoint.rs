@@ -55,7 +55,7 @@ pub struct Header {
     /// Rigid bodies: the body and body_offset arrays follow the interface array.
     #[serde(default)]
     pub bodies: bool,
-    /// Implicit-midpoint heat: the heat_start array follows.
+    /// Trapezoidal (Crank–Nicolson) heat: the heat_start array follows.
     #[serde(default)]
     pub heat_start: bool,
     /// Entries of each table (crate::fields::TABLES), stored after the particle

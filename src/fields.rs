@@ -25,7 +25,7 @@ pub enum Holder {
     Interface,
     /// Scenes with rigid bodies.
     Bodies,
-    /// Heat integrated by the implicit midpoint rule (R18 Algorithm 3.1).
+    /// Heat integrated by the trapezoidal rule (R18 Algorithm 3.1).
     ImplicitHeat,
     /// Scenes whose schedule holds a repeat (solver slots).
     Solvers,
@@ -66,7 +66,7 @@ impl Held {
     /// `backend::Pipeline::held`, checked in tests/fields.rs).
     pub fn of_model(m: &crate::model::Model) -> Held {
         let implicit_heat = m.is_thermal()
-            && m.heat.integrator == crate::scene::HeatIntegrator::ImplicitMidpoint;
+            && m.heat.integrator == crate::scene::HeatIntegrator::Trapezoidal;
         Held {
             heat: m.is_thermal(),
             interface: m.needs_interface(),

@@ -329,18 +329,18 @@ gpu_struct! {
     pub struct Solve {
         /// `Formulation::code`.
         pub formulation: u32,
-        /// HEAT_EULER or HEAT_IMPLICIT_MIDPOINT.
+        /// HEAT_EULER or HEAT_TRAPEZOIDAL.
         pub heat_integrator: u32,
-        /// Implicit midpoint: converged when max|h^{k+1} − h^k| ≤ this × max|h^{k+1} − h^n|.
+        /// Trapezoidal rule: converged when max|h^{k+1} − h^k| ≤ this × max|h^{k+1} − h^n|.
         pub heat_tolerance: f32,
-        /// Implicit midpoint: the repeat's bound.
+        /// Trapezoidal rule: the repeat's bound.
         pub heat_max_iterations: u32,
     }
 }
 
 /// `solve.heat_integrator` codes.
 pub const HEAT_EULER: u32 = 0;
-pub const HEAT_IMPLICIT_MIDPOINT: u32 = 1;
+pub const HEAT_TRAPEZOIDAL: u32 = 1;
 
 gpu_struct! {
     /// Arithmetic literals for the shaders (`SHADER_CONSTS`). lavapipe's compiler
@@ -523,7 +523,7 @@ impl Params {
             formulation: m.formulation.code(),
             heat_integrator: match m.heat.integrator {
                 crate::scene::HeatIntegrator::Euler => HEAT_EULER,
-                crate::scene::HeatIntegrator::ImplicitMidpoint => HEAT_IMPLICIT_MIDPOINT,
+                crate::scene::HeatIntegrator::Trapezoidal => HEAT_TRAPEZOIDAL,
             },
             heat_tolerance: m.heat.tolerance as f32,
             heat_max_iterations: m.heat.max_iterations,

@@ -81,9 +81,9 @@ pub enum HeatIntegrator {
     /// h^{n+1} = h^n + Δt ḣ(T^n) (F22, J22).
     #[default]
     Euler,
-    /// h^{n+1} = h^n + Δt ḣ(T((h^n + h^{n+1})/2)), by fixed-point iteration
-    /// (R18 Algorithm 3.1).
-    ImplicitMidpoint,
+    /// h^{n+1} = h^n + Δt/2 (ḣ(T^n) + ḣ(T^{n+1})) (Crank–Nicolson), by
+    /// fixed-point iteration (R18 Algorithm 3.1).
+    Trapezoidal,
 }
 
 /// `[heat]`: the time integration of the energy equation (heat scenes only).
@@ -92,12 +92,12 @@ pub enum HeatIntegrator {
 pub struct HeatDef {
     #[serde(default)]
     pub integrator: HeatIntegrator,
-    /// Implicit midpoint: iterate until max|h^{k+1} − h^k| / max|h^{k+1} − h^n|
+    /// Trapezoidal rule: iterate until max|h^{k+1} − h^k| / max|h^{k+1} − h^n|
     /// (the change of the iterate against the step's) is at most this (R18
     /// prints no value).
     #[serde(default = "default_heat_tolerance")]
     pub tolerance: f64,
-    /// Implicit midpoint: at most this many iterations per step (each is a
+    /// Trapezoidal rule: at most this many iterations per step (each is a
     /// conduction sweep; the GPU records them all).
     #[serde(default = "default_heat_iterations")]
     pub max_iterations: u32,

@@ -68,7 +68,7 @@ pub struct State {
     /// Particle ids of every body's members, body after body in ascending id
     /// (`Body::first`, `Body::count`): the fixed order of the per-body sums.
     pub members: Vec<u32>,
-    /// Implicit-midpoint heat only (empty otherwise): h^n, the laser source of
+    /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser source of
     /// the step, and the last iteration's |ḣ_k − ḣ_{k−1}| and |ḣ_k|.
     pub heat_start: Vec<[f32; 4]>,
     /// Scenes whose schedule holds a repeat (empty otherwise): one entry per

@@ -227,7 +227,7 @@ fn melt_block_3d_200_steps() {
     assert_bit_identical("melt_block_3d", &[], 200);
 }
 
-/// A repeat node (issue 27): R18's implicit-midpoint heat, a fixed-point
+/// A repeat node (issue 27): R18's trapezoidal heat, a fixed-point
 /// iteration ended by the device's converged flag, with Dirichlet mirror walls
 /// at the conduction limit's Δt (conduction_1d: the iteration contracts by about
 /// 0.46 per round there, so 1e-3 takes ~9), through the melting band (stefan_1d)
@@ -243,7 +243,7 @@ fn implicit_heat_repeat() {
     ];
     for (name, tolerance, steps) in scenes {
         let implicit = format!(
-            "\n[heat]\nintegrator = \"implicit_midpoint\"\ntolerance = {tolerance:e}\nmax_iterations = 12\n"
+            "\n[heat]\nintegrator = \"trapezoidal\"\ntolerance = {tolerance:e}\nmax_iterations = 12\n"
         );
         let text = std::fs::read_to_string(common::scene(name)).unwrap() + &implicit;
         let st = assert_bit_identical_text(&format!("{name}_implicit"), &text, steps);

@@ -222,7 +222,7 @@ fn flag_and_code_constants_match() {
         ("LASER_BEER_LAMBERT", rs::LASER_BEER_LAMBERT),
         ("LASER_SURFACE", rs::LASER_SURFACE),
         ("HEAT_EULER", rs::HEAT_EULER),
-        ("HEAT_IMPLICIT_MIDPOINT", rs::HEAT_IMPLICIT_MIDPOINT),
+        ("HEAT_TRAPEZOIDAL", rs::HEAT_TRAPEZOIDAL),
         (
             "SOLVER_HEAT",
             spatter::backend::SolverSlot::Heat as u32,

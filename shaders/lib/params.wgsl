@@ -117,7 +117,7 @@ struct Bodies {              // rigid bodies, F22 (39)-(40) contact (FLAG_BODIES
 
 struct Solve {                // the formulation and its solvers (backend::schedule)
     formulation: u32,
-    heat_integrator: u32,     // HEAT_EULER, HEAT_IMPLICIT_MIDPOINT
+    heat_integrator: u32,     // HEAT_EULER, HEAT_TRAPEZOIDAL
     heat_tolerance: f32,
     heat_max_iterations: u32,
 }
@@ -269,7 +269,7 @@ const PHASE_RECOIL: u32 = 16384u;
 const LASER_BEER_LAMBERT: u32 = 1u;
 const LASER_SURFACE: u32 = 2u;
 const HEAT_EULER: u32 = 0u;
-const HEAT_IMPLICIT_MIDPOINT: u32 = 1u;
+const HEAT_TRAPEZOIDAL: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;
 // Time-step limit codes (sim.dt_limit; src/model/limits.rs).
 const DT_ACOUSTIC: u32 = 0u;

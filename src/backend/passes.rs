@@ -6,7 +6,7 @@
 use super::cpu::CpuBackend;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
-    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_IMPLICIT_MIDPOINT, LASER_BEER_LAMBERT,
+    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT,
     LASER_SURFACE,
 };
 use crate::state::State;
@@ -49,14 +49,14 @@ pub enum Stage {
     /// Melting rigid bodies: melted members leave (F22 (37)), bodies touched by
     /// solidifying melt bond into the substrate.
     BodyMelt,
-    /// Implicit-midpoint heat (R18 Algorithm 3.1): keep h^n and the laser source,
+    /// Trapezoidal (Crank–Nicolson) heat (R18 Algorithm 3.1): keep h^n and the laser source,
     /// reset the heat solver.
     HeatBegin,
-    /// One fixed-point iteration: T at the midpoint enthalpy, the Dirichlet
-    /// mirrors, conduction and h^{k+1} = h^n + Δt ḣ(T_mid).
+    /// One fixed-point iteration: T of the iterate h^k, the Dirichlet mirrors,
+    /// conduction and h^{k+1} = h^n + Δt (ḣ_0 + ḣ_k)/2.
     HeatIterate,
-    /// The iteration's residual max|ḣ_k − ḣ_{k−1}| / max|ḣ_k| and the solver's
-    /// converged flag.
+    /// The iteration's residual max|ḣ_k − ḣ_{k−1}| / max|ḣ_0 + ḣ_k| and the
+    /// solver's converged flag.
     HeatResidual,
 }
 
@@ -87,7 +87,7 @@ pub struct Features {
     pub recoil: bool,
     /// Rigid bodies (F22 §2.2).
     pub bodies: bool,
-    /// Heat integrated by the implicit midpoint rule (R18 Algorithm 3.1).
+    /// Heat integrated by the trapezoidal rule (R18 Algorithm 3.1).
     pub implicit_heat: bool,
 }
 
@@ -111,7 +111,7 @@ impl Features {
             recoil: params.flag(FLAG_RECOIL),
             bodies: params.flag(FLAG_BODIES),
             implicit_heat: params.flag(FLAG_HEAT)
-                && params.solve.heat_integrator == HEAT_IMPLICIT_MIDPOINT,
+                && params.solve.heat_integrator == HEAT_TRAPEZOIDAL,
         }
     }
 }

@@ -20,7 +20,7 @@ use crate::scene::Formulation;
 /// buffer. The WGSL names the same slots (`SOLVER_*` in shaders/lib/params.wgsl).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SolverSlot {
-    /// R18 Algorithm 3.1: the implicit-midpoint heat iteration.
+    /// R18 Algorithm 3.1: the trapezoidal heat iteration.
     Heat = 0,
 }
 
@@ -78,7 +78,7 @@ pub const FORMULATIONS: [FormulationDef; 1] = [FormulationDef {
 /// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
 /// previous step, then the temperatures following the new enthalpies; or R18's
-/// implicit midpoint (`[heat] integrator`), a repeat in place of the conduction.
+/// trapezoidal rule (`[heat] integrator`), a repeat in place of the conduction.
 const WCSPH_STEP: [Stage; 16] = [
     Stage::KickDrift,     // v += Δt/2 a, x += Δt ṽ (transport velocity)
     Stage::BodyDrift,     // bodies: V, L += Δt/2 (F, τ); X += Δt V; rotate; place
@@ -123,7 +123,7 @@ fn wcsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
     (step, stage_nodes(&WCSPH_PRIME, f))
 }
 
-/// R18 Algorithm 3.1: the enthalpy update by the implicit midpoint rule, solved
+/// R18 Algorithm 3.1: the enthalpy update by the trapezoidal rule, solved
 /// by fixed-point iteration until the relative change is below the tolerance.
 fn implicit_heat(p: &Params) -> Node {
     Node::Repeat(Repeat {

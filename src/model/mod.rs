@@ -141,7 +141,7 @@ pub struct Model {
     pub limits: DtLimits,
 }
 
-/// `[heat]`, validated: Euler, or R18's implicit midpoint with its fixed-point
+/// `[heat]`, validated: Euler, or R18's trapezoidal rule with its fixed-point
 /// iteration's tolerance and cap.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeatIntegration {

@@ -15,7 +15,7 @@
 //!   Dirichlet wall (J22 (25)); adiabatic walls and free surfaces add nothing.
 //!   ∇_iW·r_ij = r dW/dr. A laser source (heat.w, left by the laser pass) adds to
 //!   the rate, surface losses (evaporation, radiation; `surface_loss`) subtract.
-//!   Explicit Euler: h_i += Δt dh_i/dt (J22 (21)); or the implicit midpoint rule
+//!   Explicit Euler: h_i += Δt dh_i/dt (J22 (21)); or the trapezoidal rule
 //!   (R18 Algorithm 3.1, `begin` and the iteration below). V_j = m_j/ρ_j with
 //!   summation density for fluids and ρ0 for solids and walls, which do not
 //!   compress. Each pair's flux is antisymmetric, so the total enthalpy Σ m h
@@ -148,14 +148,17 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
         });
 }
 
-/// The implicit midpoint rule (R18 Algorithm 3.1),
-///   h^{n+1} = h^n + Δt ḣ(T((h^n + h^{n+1})/2)),
-/// solved by fixed-point iteration h^{k+1} = h^n + Δt ḣ_k, ḣ_k = ḣ(T((h^n + h^k)/2)),
-/// from h^0 = h^n (whose first iterate is the explicit Euler step) until
-/// max|ḣ_k − ḣ_{k−1}| ≤ tol · max|ḣ_k| over conducting particles, i.e.
-/// max|h^{k+1} − h^k| ≤ tol · max|h^{k+1} − h^n| without the rounding of h^n
-/// (ḣ_{−1} = 0, so the first iteration's residual is 1). Conduction, surface losses and
-/// the Dirichlet mirrors follow the midpoint temperature; the laser source and
+/// The trapezoidal rule (Crank–Nicolson) of R18 Algorithm 3.1 (its text says
+/// "implicit midpoint"; the algorithm it prints is this),
+///   h^{n+1} = h^n + Δt/2 (ḣ(T^n) + ḣ(T(h^{n+1}))),
+/// solved by fixed-point iteration h^{k+1} = h^n + Δt/2 (ḣ_0 + ḣ_k),
+/// ḣ_k = ḣ(T(h^k)), from h^0 = h^n (so the first iterate is the explicit Euler
+/// step) until
+///   max|h^{k+1} − h^k| / max|h^{k+1} − h^n| = max|ḣ_k − ḣ_{k−1}| / max|ḣ_0 + ḣ_k|
+/// is at most the tolerance (over conducting particles; the first iteration
+/// counts 1 unless nothing changes). R18 measures |ΔT|/T instead, which in
+/// kelvin stops long before a step's own change has converged. Conduction,
+/// surface losses and the Dirichlet mirrors follow T(h^k); the laser source and
 /// viscous heating are those of the step. T and f_l of h^{n+1} and the phase
 /// switches follow in `temperature` after the loop, as for Euler.
 ///
@@ -186,32 +189,34 @@ pub fn heat_converged(st: &State) -> bool {
     st.solvers[SolverSlot::Heat as usize].converged != 0
 }
 
-/// `iterate_temperature`: T and f_l at the midpoint enthalpy (h^n + h^k)/2.
+/// `iterate_temperature`: T and f_l of the iterate h^k.
 pub fn iterate_temperature(pr: &Params, st: &mut State) {
     if heat_converged(st) {
         return;
     }
     let n = st.active();
-    let (start, phase) = (&st.heat_start, &st.phase);
+    let phase = &st.phase;
     st.heat[..n]
         .par_iter_mut()
         .enumerate()
         .for_each(|(i, hv)| {
             if pr.conducts(phase[i]) {
-                let (t, fl) = temperature_of(pr, phase[i], (start[i][0] + hv[0]) * 0.5);
+                let (t, fl) = temperature_of(pr, phase[i], hv[0]);
                 hv[1] = t;
                 hv[2] = fl;
             }
         });
 }
 
-/// `iterate_conduct`: h^{k+1} = h^n + Δt ḣ_k, and |ḣ_k − ḣ_{k−1}| and |ḣ_k| into
-/// heat_start.zw (rates, not enthalpies: lavapipe folds (a + b) − a to b).
+/// `iterate_conduct`: ḣ_k (kept as ḣ_0 in heat_start.z on the first
+/// iteration), h^{k+1} = h^n + Δt ((ḣ_0 + ḣ_k)/2), and |ḣ_k − ḣ_{k−1}| into
+/// heat_start.w (rates, not enthalpies: lavapipe folds (a + b) − a to b).
 pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     if heat_converged(st) {
         return;
     }
     let dt = st.sim.dt;
+    let first = st.solvers[SolverSlot::Heat as usize].iterations == 0;
     let s: &State = st;
     let rates: Vec<f32> = (0..s.active())
         .into_par_iter()
@@ -230,15 +235,17 @@ pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
         .enumerate()
         .for_each(|(i, ((hv, hs), rate))| {
             if pr.conducts(phase[i]) {
-                hs[2] = (rate - hv[3]).abs();
-                hs[3] = rate.abs();
-                hv[0] = hs[0] + dt * rate;
+                if first {
+                    hs[2] = rate;
+                }
+                hs[3] = (rate - hv[3]).abs();
+                hv[0] = hs[0] + dt * ((hs[2] + rate) * 0.5);
                 hv[3] = rate;
             }
         });
 }
 
-/// `heat_residual` + `heat_residual_final`: max|ḣ_k − ḣ_{k−1}| / max|ḣ_k|
+/// `heat_residual` + `heat_residual_final`: max|ḣ_k − ḣ_{k−1}| / max|ḣ_0 + ḣ_k|
 /// over conducting particles (max is exact and order-free: the GPU's tree gives
 /// the same bits), one more iteration, and the flag.
 pub fn residual(pr: &Params, st: &mut State) {
@@ -248,11 +255,17 @@ pub fn residual(pr: &Params, st: &mut State) {
     let (dmax, smax) = (0..st.active())
         .into_par_iter()
         .filter(|&i| pr.conducts(st.phase[i]))
-        .map(|i| (st.heat_start[i][2], st.heat_start[i][3]))
+        .map(|i| (st.heat_start[i][3], (st.heat_start[i][2] + st.heat[i][3]).abs()))
         .reduce(|| (0.0f32, 0.0f32), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     let s = &mut st.solvers[SolverSlot::Heat as usize];
+    s.residual = if smax == 0.0 {
+        0.0
+    } else if s.iterations == 0 {
+        1.0
+    } else {
+        dmax / smax
+    };
     s.iterations += 1;
-    s.residual = if smax > 0.0 { dmax / smax } else { 0.0 };
     s.converged = (s.residual <= pr.solve.heat_tolerance) as u32;
 }
 

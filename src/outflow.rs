@@ -205,16 +205,16 @@ pub fn new_removals(m: &Model, st: &State, reported: &mut HashSet<u32>) -> Vec<R
     let mut out: Vec<RemovalEvent> = (st.active()..st.len())
         .filter(|&i| reported.insert(st.id[i]))
         .map(|i| {
-            let w = |a| crate::output::world_coord(m, st, i, a) as f64;
+            let [x, y, z] = m.to_world(st.pos[i]);
             let v = st.vel[i];
             RemovalEvent {
                 id: st.id[i],
                 phase: m.phases[st.phase[i] as usize].name.clone(),
                 time: st.pos[i][3] as f64,
                 side: side_name(m, st, i),
-                x: w(0),
-                y: w(1),
-                z: w(2),
+                x,
+                y,
+                z,
                 speed: ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt(),
                 mass: st.mass[i] as f64,
             }

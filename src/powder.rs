@@ -103,22 +103,22 @@ pub struct PowderBed {
 pub const NO_GRAIN: u32 = u32::MAX;
 
 impl PowderBed {
-    /// Records each particle's grain (by id) from the initial state, whose
-    /// positions are the lattice sites setup filled.
-    pub fn attach(&mut self, origin: [f64; 3], dim: usize, initial: &crate::state::State) {
-        let mut members = vec![NO_GRAIN; initial.len()];
-        for i in 0..initial.len() {
-            if initial.phase[i] as usize != self.spec.phase {
+    /// Records each particle's grain (by id) from the initial fill: (id, phase,
+    /// world position) of each of its `count` particles, the positions being the
+    /// lattice sites setup filled.
+    pub fn attach(
+        &mut self,
+        dim: usize,
+        count: usize,
+        particles: impl IntoIterator<Item = (u32, u32, [f64; 3])>,
+    ) {
+        let mut members = vec![NO_GRAIN; count];
+        for (id, phase, x) in particles {
+            if phase as usize != self.spec.phase {
                 continue;
             }
-            let p = initial.pos[i];
-            let x = [
-                p[0] as f64 + origin[0],
-                p[1] as f64 + origin[1],
-                p[2] as f64 + origin[2],
-            ];
             if let Some(k) = self.grain_at(x, dim) {
-                members[initial.id[i] as usize] = k as u32;
+                members[id as usize] = k as u32;
             }
         }
         self.members = members;

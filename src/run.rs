@@ -50,9 +50,15 @@ pub fn load_str(label: &str, text: &str, sets: &[String]) -> Result<Loaded, Inpu
 
 /// A powder scene's grain of each particle id, from the initial state.
 fn attach_grains(model: &mut Model, initial: &State) {
-    let (origin, dim) = (model.origin, model.dim as usize);
+    if model.powder.is_none() {
+        return;
+    }
+    let particles: Vec<(u32, u32, [f64; 3])> = (0..initial.len())
+        .map(|i| (initial.id[i], initial.phase[i], model.to_world(initial.pos[i])))
+        .collect();
+    let dim = model.dim as usize;
     if let Some(b) = model.powder.as_mut() {
-        b.attach(origin, dim, initial);
+        b.attach(dim, initial.len(), particles);
     }
 }
 

@@ -149,7 +149,7 @@ fn beyond_faces(m: &Model, st: &State, i: usize) -> Vec<(usize, usize, f64, bool
         if m.periodic[a] {
             continue;
         }
-        let x = st.pos[i][a] as f64 + m.origin[a];
+        let x = m.to_world(st.pos[i])[a];
         let (lo, hi) = (m.domain_lo[a], m.domain_hi[a]);
         for (side, beyond) in [(0, lo - x), (1, x - hi)] {
             if beyond > 0.0 {
@@ -256,7 +256,7 @@ fn wall_trip(
             m.wall_layers
         ),
     };
-    (AXES[a], st.pos[i][a] as f64 + m.origin[a], what)
+    (AXES[a], m.to_world(st.pos[i])[a], what)
 }
 
 /// The face a removed particle left through: the one it is farthest beyond
@@ -265,7 +265,7 @@ fn wall_trip(
 pub fn exit_face(m: &Model, st: &State, i: usize) -> (usize, usize, bool) {
     let mut best = (0, 0, f64::NEG_INFINITY, false);
     for a in (0..m.dim as usize).filter(|&a| !m.periodic[a]) {
-        let x = st.pos[i][a] as f64 + m.origin[a];
+        let x = m.to_world(st.pos[i])[a];
         let (lo, hi) = m.keep_box(a);
         let (lo, hi) = (lo + m.origin[a], hi + m.origin[a]);
         for (side, beyond) in [(0, lo - x), (1, x - hi)] {
@@ -282,7 +282,7 @@ pub fn exit_face(m: &Model, st: &State, i: usize) -> (usize, usize, bool) {
 /// through every wall layer, which always stops the run.
 fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
     let (a, side, open) = exit_face(m, st, i);
-    let x = st.pos[i][a] as f64 + m.origin[a];
+    let x = m.to_world(st.pos[i])[a];
     if !open {
         let face = [m.domain_lo[a], m.domain_hi[a]][side];
         return Some(wall_trip(m, st, i, a, side, (x - face).abs()));

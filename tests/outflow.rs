@@ -45,7 +45,7 @@ fn a_jet_leaves_through_the_open_side_at_its_ballistic_times() {
         .map(|i| {
             (
                 l.state.id[i] as u64,
-                l.state.pos[i][0] as f64 + l.model.origin[0],
+                l.model.to_world(l.state.pos[i])[0],
             )
         })
         .collect();

@@ -81,7 +81,7 @@ fn hydrostatic_start_stacks_the_layers() {
         if !ph.is_fluid() {
             continue;
         }
-        let y = st.pos[i][1] as f64 + m.origin[1];
+        let y = m.to_world(st.pos[i])[1];
         let (rho_l, rho_g) = (1000.0, 10.0);
         let expected = if y > 0.1 {
             rho_g * g * (0.2 - y)

@@ -13,7 +13,7 @@ fn conducting(m: &Model, st: &State) -> Vec<(f64, f64, usize)> {
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
         .map(|i| {
             (
-                st.pos[i][ax] as f64 + m.origin[ax],
+                m.to_world(st.pos[i])[ax],
                 st.heat[i][1] as f64,
                 st.phase[i] as usize,
             )
@@ -30,7 +30,7 @@ fn wall_temperatures(m: &Model, st: &State) -> (Option<f64>, Option<f64>) {
         let Some(th) = ph.thermal.filter(|_| !ph.conducts()) else {
             continue;
         };
-        let x = st.pos[i][ax] as f64 + m.origin[ax];
+        let x = m.to_world(st.pos[i])[ax];
         if x < m.domain_lo[ax] {
             lo = Some(th.temperature);
         } else if x > m.domain_hi[ax] {
@@ -334,7 +334,8 @@ pub fn rosenthal(m: &Model, st: &State) -> (String, f64, Vec<String>) {
     let pts: Vec<(f64, f64, f64, f64, usize)> = (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
         .map(|i| {
-            let x = |a: usize| st.pos[i][a] as f64 + m.origin[a];
+            let world = m.to_world(st.pos[i]);
+            let x = |a: usize| world[a];
             let lateral = if m.dim == 3 { x(1) - beam[1] } else { 0.0 };
             (
                 x(0) - beam[0],

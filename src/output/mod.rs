@@ -47,15 +47,6 @@ pub struct Field {
     pub values: Values,
 }
 
-/// World position of particle `i`, axis `a`, as written to every output: the stored
-/// grid-relative f32 position plus the grid origin, rounded once to f32.
-pub fn world_coord(m: &Model, st: &State, i: usize, a: usize) -> f32 {
-    if a >= m.dim as usize {
-        return 0.0;
-    }
-    (st.pos[i][a] as f64 + m.origin[a]) as f32
-}
-
 /// Every per-particle field a frame carries, from the field registry's `frames`
 /// channels in registry order: x, y, z (m), vx, vy, vz (m/s), density (kg/m³),
 /// pressure (Pa), mass (kg), phase (index into the scene's phases), id (the
@@ -119,9 +110,11 @@ pub fn body_channels(_m: &Model, st: &State) -> Vec<Field> {
     channel("body", Values::U32(body))
 }
 
-/// Position channels: world coordinates x, y, z (m).
+/// Position channels: world coordinates x, y, z (m), `Model::to_world` rounded
+/// once to f32.
 pub fn position_channels(m: &Model, st: &State) -> Vec<Field> {
-    let coord = |a: usize| Values::F32((0..st.len()).map(|i| world_coord(m, st, i, a)).collect());
+    let world: Vec<[f64; 3]> = st.pos.iter().map(|&p| m.to_world(p)).collect();
+    let coord = |a: usize| Values::F32(world.iter().map(|x| x[a] as f32).collect());
     ["x", "y", "z"]
         .into_iter()
         .enumerate()
@@ -372,7 +365,7 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         if ph.kind == PhaseKind::Gas {
             continue;
         }
-        let x: Vec<f64> = (0..3).map(|a| world_coord(m, st, i, a) as f64).collect();
+        let x = m.to_world(st.pos[i]);
         top = top.max(x[up]);
         d.melted_volume += fl as f64 * cell;
         if fl >= 0.5 {

@@ -141,7 +141,7 @@ impl Outflow {
 }
 
 fn side_name(m: &Model, st: &State, i: usize) -> &'static str {
-    let (a, side, _) = crate::watchdog::exit_face(m, st, i);
+    let (a, side, _) = m.exit_face(m.to_world(st.pos[i]));
     SIDE_NAMES[a][side]
 }
 

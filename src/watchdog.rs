@@ -141,25 +141,6 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
     None
 }
 
-/// How far particle `i` is beyond each face of the domain: (axis, side, distance
-/// in m, the side is open) for every non-periodic face it is outside of.
-fn beyond_faces(m: &Model, st: &State, i: usize) -> Vec<(usize, usize, f64, bool)> {
-    let mut out = Vec::new();
-    for a in 0..m.dim as usize {
-        if m.periodic[a] {
-            continue;
-        }
-        let x = m.to_world(st.pos[i])[a];
-        let (lo, hi) = (m.domain_lo[a], m.domain_hi[a]);
-        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
-            if beyond > 0.0 {
-                out.push((a, side, beyond, m.open_sides[a][side]));
-            }
-        }
-    }
-    out
-}
-
 /// Fluid leaking into the wall layers (issue 18): the deepest penetration behind a
 /// closed wall face and how many fluid particles are more than ½Δx behind one.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -209,7 +190,8 @@ pub fn leakage(m: &Model, st: &State) -> Leakage {
         if !m.phases[st.phase[i] as usize].is_fluid() {
             continue;
         }
-        let deepest = beyond_faces(m, st, i)
+        let deepest = m
+            .beyond_faces(m.to_world(st.pos[i]))
             .into_iter()
             .filter(|f| !f.3)
             .max_by(|x, y| x.2.total_cmp(&y.2));
@@ -228,7 +210,7 @@ pub fn leakage(m: &Model, st: &State) -> Leakage {
 /// watchdog allows. (One beyond an open face has been removed by the step.)
 fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
     let depth = m.wall_stop_depth() * m.dx;
-    for (a, side, beyond, open) in beyond_faces(m, st, i) {
+    for (a, side, beyond, open) in m.beyond_faces(m.to_world(st.pos[i])) {
         if open || beyond <= depth {
             continue;
         }
@@ -259,30 +241,13 @@ fn wall_trip(
     (AXES[a], m.to_world(st.pos[i])[a], what)
 }
 
-/// The face a removed particle left through: the one it is farthest beyond
-/// (open or walled), by axis and side. The step decides removal in f32 against the
-/// same faces, so a particle within rounding of a face is still given that face.
-pub fn exit_face(m: &Model, st: &State, i: usize) -> (usize, usize, bool) {
-    let mut best = (0, 0, f64::NEG_INFINITY, false);
-    for a in (0..m.dim as usize).filter(|&a| !m.periodic[a]) {
-        let x = m.to_world(st.pos[i])[a];
-        let (lo, hi) = m.keep_box(a);
-        let (lo, hi) = (lo + m.origin[a], hi + m.origin[a]);
-        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
-            if beyond > best.2 {
-                best = (a, side, beyond, m.open_sides[a][side]);
-            }
-        }
-    }
-    (best.0, best.1, best.3)
-}
-
 /// A particle the step removed (issue 18): leaving through an open side is normal
 /// unless the scene's policy is "stop"; leaving behind a walled side means it went
 /// through every wall layer, which always stops the run.
 fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
-    let (a, side, open) = exit_face(m, st, i);
-    let x = m.to_world(st.pos[i])[a];
+    let world = m.to_world(st.pos[i]);
+    let (a, side, open) = m.exit_face(world);
+    let x = world[a];
     if !open {
         let face = [m.domain_lo[a], m.domain_hi[a]][side];
         return Some(wall_trip(m, st, i, a, side, (x - face).abs()));
@@ -334,7 +299,7 @@ mod tests {
         let (m, mut st) = scene();
         assert_eq!(leakage(&m, &st).deepest_dx, 0.0);
         let f = fluid(&m, &st);
-        let x_lo = (m.domain_lo[0] - m.origin[0]) as f32;
+        let x_lo = m.to_local(m.domain_lo)[0] as f32;
         st.pos[f[0]][0] = x_lo - 0.3 * m.dx as f32;
         st.pos[f[1]][0] = x_lo - 0.7 * m.dx as f32;
         let l = leakage(&m, &st);
@@ -366,7 +331,7 @@ mod tests {
         let (mut m, mut st) = scene();
         st.rho.iter_mut().for_each(|r| *r = 1000.0);
         let f = fluid(&m, &st);
-        let x_lo = m.domain_lo[0] - m.origin[0];
+        let x_lo = m.to_local(m.domain_lo)[0];
         // By default a leak into the wall layers is measured, not fatal; through
         // all of them (3 for the quintic) it stops the run.
         st.pos[f[0]][0] = (x_lo - 0.6 * m.dx) as f32;
@@ -389,7 +354,7 @@ mod tests {
             "{}",
             t.reason
         );
-        st.pos[f[0]][0] = (m.domain_lo[0] - m.origin[0] + 0.5 * m.dx) as f32;
+        st.pos[f[0]][0] = (x_lo + 0.5 * m.dx) as f32;
         st.rho[f[1]] = 5000.0;
         let t = scan(&m, &st).expect("density");
         assert_eq!(t.field, "density");

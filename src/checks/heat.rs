@@ -128,7 +128,7 @@ pub fn two_materials(m: &Model, st: &State, interface: f64) -> (String, f64, Vec
 pub fn total_enthalpy(m: &Model, st: &State) -> f64 {
     (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
-        .map(|i| st.mass[i] as f64 * crate::output::absolute_enthalpy(m, st, i))
+        .map(|i| st.mass[i] as f64 * m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0]))
         .sum()
 }
 

@@ -20,6 +20,7 @@ use domain::{
 pub use domain::{lattice_sites, LATTICE_TOLERANCE};
 use phases::{artificial_nu, interface_viscosity_nu, phase_table, solid_fluid_viscosity};
 use thermal::thermal_table;
+pub use thermal::STEFAN_BOLTZMANN;
 
 use crate::error::InputError;
 use crate::scene::{

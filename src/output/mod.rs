@@ -138,16 +138,6 @@ pub fn velocity_channels(_m: &Model, st: &State) -> Vec<Field> {
         .collect()
 }
 
-/// Specific enthalpy h(T) of particle i (J/kg): the stored value plus its phase's
-/// reference enthalpy (`Thermal::reference_enthalpy`).
-pub fn absolute_enthalpy(m: &Model, st: &State, i: usize) -> f64 {
-    let ph = &m.phases[st.phase[i] as usize];
-    if !ph.conducts() {
-        return 0.0; // a Dirichlet wall's heat.x is its fixed temperature
-    }
-    st.heat[i][0] as f64 + ph.thermal.map_or(0.0, |t| t.reference_enthalpy())
-}
-
 /// Heat scenes: temperature (K), liquid fraction and specific enthalpy (J/kg).
 /// A particle of a phase without thermal properties (a wall with no temperature,
 /// which insulates) has no temperature: it is written as the scene's ambient
@@ -171,7 +161,7 @@ pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     };
     let enthalpy = Values::F32(
         (0..st.len())
-            .map(|i| absolute_enthalpy(m, st, i) as f32)
+            .map(|i| m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0]) as f32)
             .collect(),
     );
     vec![
@@ -314,8 +304,6 @@ pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
         return (0.0, 0.0);
     }
     let (mut evap, mut rad) = (0.0, 0.0);
-    let ta4 = m.ambient_temperature.powi(4);
-    const SIGMA: f64 = 5.670374419e-8;
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
         let Some(th) = ph.thermal.filter(|_| ph.conducts()) else {
@@ -326,7 +314,7 @@ pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
         if let Some(e) = th.evaporation {
             evap += e.flux(t, th.heat_capacity) * area;
         }
-        rad += th.emissivity * SIGMA * (t.powi(4) - ta4) * area;
+        rad += th.radiated_flux(t, m.ambient_temperature) * area;
     }
     (evap, rad)
 }
@@ -361,7 +349,7 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         }
         let [_, t, fl, _] = st.heat[i];
         d.max_temperature = d.max_temperature.max(t as f64);
-        d.total_enthalpy += st.mass[i] as f64 * absolute_enthalpy(m, st, i);
+        d.total_enthalpy += st.mass[i] as f64 * ph.absolute_enthalpy(st.heat[i][0]);
         if ph.kind == PhaseKind::Gas {
             continue;
         }

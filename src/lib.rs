@@ -18,6 +18,7 @@ pub mod output;
 pub mod params;
 pub mod portable_math;
 pub mod powder;
+pub mod random;
 pub mod run;
 pub mod scene;
 pub mod setup;

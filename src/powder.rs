@@ -24,7 +24,7 @@
 
 use crate::error::InputError;
 use crate::scene::PowderDef;
-use crate::setup::SplitMix;
+use crate::random::SplitMix;
 
 /// Consecutive grains removed by the levelling before pouring stops.
 const POUR_MISSES: usize = 200;

@@ -23,8 +23,8 @@
 //! sphere with the powder phase); rigid bodies come with the rest of issue 17.
 
 use crate::error::InputError;
-use crate::scene::PowderDef;
 use crate::random::SplitMix;
+use crate::scene::PowderDef;
 
 /// Consecutive grains removed by the levelling before pouring stops.
 const POUR_MISSES: usize = 200;

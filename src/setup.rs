@@ -5,8 +5,8 @@
 //! ones at the same site, so "gas everywhere, then liquid in a box" works.
 
 use crate::error::InputError;
-use crate::random::SplitMix;
 use crate::model::{BodySource, Model};
+use crate::random::SplitMix;
 use crate::scene::{SceneFile, ShapeDef};
 use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT, NO_BODY};
 

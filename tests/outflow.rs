@@ -42,12 +42,7 @@ fn a_jet_leaves_through_the_open_side_at_its_ballistic_times() {
     let water = l.model.phase_index("water").unwrap() as u32;
     let x0: HashMap<u64, f64> = (0..l.state.len())
         .filter(|&i| l.state.phase[i] == water)
-        .map(|i| {
-            (
-                l.state.id[i] as u64,
-                l.model.to_world(l.state.pos[i])[0],
-            )
-        })
+        .map(|i| (l.state.id[i] as u64, l.model.to_world(l.state.pos[i])[0]))
         .collect();
     assert_eq!(x0.len(), 224);
     let removed = json_messages(&mcap, "/removed");

@@ -7,6 +7,7 @@ pub mod bodies;
 pub mod checkpoint;
 pub mod checks;
 pub mod compare;
+pub mod diagnostics;
 pub mod error;
 pub mod fields;
 pub mod gpu_layout;

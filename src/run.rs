@@ -5,9 +5,11 @@ use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
 use crate::backend::{Backend, DeviceLost};
 use crate::checkpoint::{self, CheckpointSink};
 use crate::checks::{CheckResult, Checker};
+use crate::diagnostics::{self, Leakage, BODIES_TOPIC, DIAGNOSTICS_TOPIC, REMOVED_TOPIC};
 use crate::error::{InputError, SpatterError};
 use crate::model::{self, EndCondition, Model};
-use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
+use crate::outflow::RemovalLog;
+use crate::output::{mcap_out::McapSink, vtk::VtkSink};
 use crate::params::Params;
 use crate::scene;
 use crate::setup;
@@ -54,7 +56,13 @@ fn attach_grains(model: &mut Model, initial: &State) {
         return;
     }
     let particles: Vec<(u32, u32, [f64; 3])> = (0..initial.len())
-        .map(|i| (initial.id[i], initial.phase[i], model.to_world(initial.pos[i])))
+        .map(|i| {
+            (
+                initial.id[i],
+                initial.phase[i],
+                model.to_world(initial.pos[i]),
+            )
+        })
         .collect();
     let dim = model.dim as usize;
     if let Some(b) = model.powder.as_mut() {
@@ -146,7 +154,7 @@ pub struct RunReport {
     /// The checkpoint written last, if any.
     pub last_checkpoint: Option<PathBuf>,
     /// Wall leakage over every state the run read back (issue 18).
-    pub leakage: watchdog::Leakage,
+    pub leakage: Leakage,
     /// The melt track of a laser scene (issue 16).
     pub track: Option<crate::track::TrackProfile>,
 }
@@ -169,33 +177,42 @@ pub struct Outputs {
     pub backend: String,
     last_diag_step: Option<u32>,
     last_checkpoint: Option<PathBuf>,
+    /// The `/removed` events written so far.
+    removals: RemovalLog,
 }
 
 impl Outputs {
+    /// A frame of `st` (MCAP `/particles` with its `/bodies` message, VTK).
     fn frame(&mut self, m: &Model, st: &State) -> Result<(), String> {
         if let Some(s) = self.mcap.as_mut() {
-            s.frame(m, st)?;
+            let written = s.frame(m, st)?;
+            if written && s.has(BODIES_TOPIC) {
+                let bodies = diagnostics::bodies_message(m, st);
+                s.message(BODIES_TOPIC, st.sim.time as f64, &bodies)?;
+            }
         }
         if let Some(v) = self.vtk.as_mut() {
             v.frame(m, st)?;
         }
         Ok(())
     }
-    /// `track` has observed `st` already (its depression under the beam).
+    /// The `/removed` events since the last record, then the `/diagnostics`
+    /// record of `st` (once per step). `track` has observed `st` already (its
+    /// depression under the beam).
     fn diagnostics(&mut self, m: &Model, st: &State, track: Option<&Track>) -> Result<(), String> {
         if self.last_diag_step == Some(st.sim.step) {
             return Ok(());
         }
         self.last_diag_step = Some(st.sim.step);
-        match self.mcap.as_mut() {
-            Some(s) => {
-                s.removals(m, st)?;
-                let mut d = output::diagnostics(m, st);
-                d.depression_depth = track.and_then(Track::depression_now);
-                s.diagnostics(&d)
-            }
-            None => Ok(()),
+        let Some(s) = self.mcap.as_mut() else {
+            return Ok(());
+        };
+        for e in self.removals.new_events(m, st) {
+            s.message(REMOVED_TOPIC, e.time, &e)?;
         }
+        let mut d = diagnostics::record(m, st);
+        d.depression_depth = track.and_then(Track::depression_now);
+        s.message(DIAGNOSTICS_TOPIC, d.time, &d)
     }
     fn checkpoint(&mut self, m: &Model, st: &State) -> Result<(), String> {
         if let Some(c) = self.checkpoints.as_mut() {
@@ -339,7 +356,7 @@ pub fn run(
     let cap = chunk_cap(st.len());
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
-    let mut leakage = watchdog::leakage(m, &st);
+    let mut leakage = Leakage::of(m, &st);
     let mut leak_warned = false;
     let mut end = RunEnd::Completed;
     while trip.is_none() {
@@ -395,7 +412,7 @@ pub fn run(
         if trip.is_some() {
             continue;
         }
-        leakage.absorb(watchdog::leakage(m, &st));
+        leakage.absorb(Leakage::of(m, &st));
         if !leak_warned && leakage.beyond_half_dx > 0 && !opts.quiet {
             leak_warned = true;
             eprintln!(
@@ -437,7 +454,7 @@ pub fn run(
         Some(first) => {
             let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
-            leakage.absorb(watchdog::leakage(m, &bad));
+            leakage.absorb(Leakage::of(m, &bad));
             if let Some(t) = track.as_mut() {
                 t.observe(m, &bad);
             }
@@ -449,7 +466,7 @@ pub fn run(
         }
         None => {
             let fin = fin.expect("the final state is read when nothing tripped");
-            leakage.absorb(watchdog::leakage(m, &fin));
+            leakage.absorb(Leakage::of(m, &fin));
             if let Some(t) = track.as_mut() {
                 t.observe(m, &fin);
             }
@@ -463,8 +480,12 @@ pub fn run(
     };
     let track = track.map(|t| t.finish(m, &final_state));
     if let (Some(sink), Some(profile)) = (out.mcap.as_mut(), track.as_ref()) {
-        sink.track(final_state.sim.time as f64, profile)
-            .map_err(rt)?;
+        sink.message(
+            diagnostics::TRACK_TOPIC,
+            final_state.sim.time as f64,
+            profile,
+        )
+        .map_err(rt)?;
     }
     out.finish().map_err(rt)?;
     let wall_s = start.elapsed().as_secs_f64();
@@ -619,7 +640,9 @@ mod tests {
             command: "test",
         };
         let mut out = Outputs {
-            mcap: Some(McapSink::create(&mcap, &l.model, &prov).unwrap()),
+            mcap: Some(
+                McapSink::create(&mcap, &l.model, &prov, &diagnostics::topics(&l.model)).unwrap(),
+            ),
             checkpoints: Some(CheckpointSink::create(&dir.join("ckpt").to_string_lossy()).unwrap()),
             ..Default::default()
         };

@@ -141,71 +141,6 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
     None
 }
 
-/// Fluid leaking into the wall layers (issue 18): the deepest penetration behind a
-/// closed wall face and how many fluid particles are more than ½Δx behind one.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Leakage {
-    /// Deepest penetration behind a wall face, in Δx (0 with none).
-    pub deepest_dx: f64,
-    /// The particle (id) and face of the deepest penetration, and when.
-    pub particle: Option<u32>,
-    pub face: Option<(usize, usize)>,
-    pub time: f64,
-    /// Fluid particles more than ½Δx behind a wall face.
-    pub beyond_half_dx: u64,
-}
-
-impl Leakage {
-    /// Keep the deeper of two samples, and the larger count.
-    pub fn absorb(&mut self, other: Leakage) {
-        if other.deepest_dx > self.deepest_dx {
-            let count = self.beyond_half_dx;
-            *self = other;
-            self.beyond_half_dx = count;
-        }
-        self.beyond_half_dx = self.beyond_half_dx.max(other.beyond_half_dx);
-    }
-
-    pub fn summary(&self) -> String {
-        match (self.particle, self.face) {
-            (Some(id), Some((a, side))) => format!(
-                "deepest fluid penetration {:.2} dx (particle {id} behind the {} wall, t = {:.4e} s), at most {} particle(s) beyond 0.5 dx at once",
-                self.deepest_dx,
-                crate::scene::SIDE_NAMES[a][side],
-                self.time,
-                self.beyond_half_dx
-            ),
-            _ => "no fluid particle behind a wall face".into(),
-        }
-    }
-}
-
-/// The wall leakage of one state.
-pub fn leakage(m: &Model, st: &State) -> Leakage {
-    let mut l = Leakage {
-        time: st.sim.time as f64,
-        ..Leakage::default()
-    };
-    for i in 0..st.active() {
-        if !m.phases[st.phase[i] as usize].is_fluid() {
-            continue;
-        }
-        let deepest = m
-            .beyond_faces(m.to_world(st.pos[i]))
-            .into_iter()
-            .filter(|f| !f.3)
-            .max_by(|x, y| x.2.total_cmp(&y.2));
-        if let Some((a, side, d, _)) = deepest {
-            let dx = d / m.dx;
-            l.beyond_half_dx += (dx > 0.5) as u64;
-            if dx > l.deepest_dx {
-                (l.deepest_dx, l.particle, l.face) = (dx, Some(st.id[i]), Some((a, side)));
-            }
-        }
-    }
-    l
-}
-
 /// A fluid particle still in the simulation deeper behind a wall face than the
 /// watchdog allows. (One beyond an open face has been removed by the step.)
 fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
@@ -290,28 +225,6 @@ mod tests {
         let (m, mut st) = scene();
         st.rho.iter_mut().for_each(|r| *r = 1000.0);
         assert_eq!(scan(&m, &st), None);
-    }
-
-    /// Issue 18: penetration behind a closed face is measured in Δx, the deepest
-    /// kept with its particle and face, and counted beyond ½Δx.
-    #[test]
-    fn leakage_measures_depth_behind_wall_faces() {
-        let (m, mut st) = scene();
-        assert_eq!(leakage(&m, &st).deepest_dx, 0.0);
-        let f = fluid(&m, &st);
-        let x_lo = m.to_local(m.domain_lo)[0] as f32;
-        st.pos[f[0]][0] = x_lo - 0.3 * m.dx as f32;
-        st.pos[f[1]][0] = x_lo - 0.7 * m.dx as f32;
-        let l = leakage(&m, &st);
-        assert!((l.deepest_dx - 0.7).abs() < 1e-3, "{l:?}");
-        assert_eq!(l.particle, Some(st.id[f[1]]));
-        assert_eq!(l.face, Some((0, 0)));
-        assert_eq!(l.beyond_half_dx, 1);
-        assert!(
-            l.summary().contains("behind the x_min wall"),
-            "{}",
-            l.summary()
-        );
     }
 
     #[test]

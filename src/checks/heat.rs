@@ -128,7 +128,9 @@ pub fn two_materials(m: &Model, st: &State, interface: f64) -> (String, f64, Vec
 pub fn total_enthalpy(m: &Model, st: &State) -> f64 {
     (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
-        .map(|i| st.mass[i] as f64 * m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0]))
+        .map(|i| {
+            st.mass[i] as f64 * m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0])
+        })
         .sum()
 }
 
@@ -475,7 +477,7 @@ impl Check for LaserEnergy {
     fn observe(&mut self, m: &Model, st: &State) {
         let t = st.sim.time as f64;
         self.initial.get_or_insert_with(|| total_enthalpy(m, st));
-        let (evap, rad) = crate::output::surface_loss_power(m, st);
+        let (evap, rad) = crate::diagnostics::surface_loss_power(m, st);
         if self.losses.last().is_none_or(|l| l.0 < t) {
             self.losses.push((t, evap + rad));
         }

@@ -338,6 +338,30 @@ fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
 }
 
 impl TrackProfile {
+    /// The mean remelt depth of the first and of the last tenth of the melted
+    /// slices (where the scan starts and where it ends); None when nothing melted.
+    pub fn end_depths(&self) -> Option<(f64, f64)> {
+        let s = &self.slices;
+        if s.is_empty() {
+            return None;
+        }
+        let tenth = (s.len() / 10).max(1);
+        let mean_depth =
+            |part: &[Slice]| part.iter().map(|x| x.depth).sum::<f64>() / part.len() as f64;
+        Some((mean_depth(&s[..tenth]), mean_depth(&s[s.len() - tenth..])))
+    }
+
+    /// The mean of a slice figure over the slices where it is finite.
+    pub fn mean(&self, f: impl Fn(&Slice) -> f64) -> f64 {
+        let v: Vec<f64> = self
+            .slices
+            .iter()
+            .map(f)
+            .filter(|v| v.is_finite())
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    }
+
     /// Lines for the end of a run.
     pub fn summary(&self, dim: u32) -> Vec<String> {
         let p = &self.pool;
@@ -365,15 +389,12 @@ impl TrackProfile {
         }
         let stats = |f: &dyn Fn(&Slice) -> f64| {
             let v: Vec<f64> = s.iter().map(f).filter(|v| v.is_finite()).collect();
-            let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            let mean = self.mean(f);
             let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
             let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             format!("mean {mean:.3e} m (min {lo:.3e}, max {hi:.3e})")
         };
-        // The first and last tenth of the melted slices: where the scan starts and ends.
-        let tenth = (s.len() / 10).max(1);
-        let mean_depth =
-            |part: &[Slice]| part.iter().map(|x| x.depth).sum::<f64>() / part.len() as f64;
+        let (first_tenth, last_tenth) = self.end_depths().expect("slices melted");
         let mut track = format!(
             "track: {} slices of {:.1e} m melted, x from {:.4e} to {:.4e} m: remelt depth {}; first tenth {:.3e} m, last tenth {:.3e} m; surface height {} relative to the initial surface",
             s.len(),
@@ -381,8 +402,8 @@ impl TrackProfile {
             s[0].x,
             s[s.len() - 1].x,
             stats(&|x| x.depth),
-            mean_depth(&s[..tenth]),
-            mean_depth(&s[s.len() - tenth..]),
+            first_tenth,
+            last_tenth,
             stats(&|x| x.height),
         );
         if dim == 3 {

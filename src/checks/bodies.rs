@@ -538,7 +538,7 @@ impl super::Check for Settling {
             metric,
             value: (u - u_ref).abs() / u_ref,
             details,
-            figures: vec![("u".into(), u), ("u_ref".into(), u_ref)],
+            figures: vec![("u".into(), u), ("u_ref".into(), u_ref), ("k".into(), k)],
         }
     }
 }

@@ -287,7 +287,7 @@ pub fn ejected_grains(m: &Model, st: &State) -> Option<(usize, usize)> {
         if !st.bodies[k].moves() {
             continue; // molten away or bonded into the substrate
         }
-        let height = st.bodies[k].x[up] as f64 + m.origin[up];
+        let height = m.to_world(st.bodies[k].x)[up];
         if height > top + 2.0 * bed.grains[g].radius {
             ejected += 1;
         }
@@ -371,7 +371,7 @@ impl BodyMotion {
         });
         let energy = 0.5 * (0..3).map(|a| lb[a] * w_body[a]).sum::<f64>();
         BodyMotion {
-            position: [0, 1, 2].map(|a| b.x[a] as f64 + m.origin[a]),
+            position: m.to_world(b.x),
             orientation: q,
             velocity: [b.v[0] as f64, b.v[1] as f64, b.v[2] as f64],
             angular_velocity: rotate(q, w_body),

@@ -329,7 +329,7 @@ fn cmd_run(
         "steps: {}, simulated time: {:.6e} s",
         report.steps, report.sim_time
     );
-    if let Some(h) = spatter::output::heat_diagnostics(&loaded.model, &report.final_state) {
+    if let Some(h) = spatter::diagnostics::heat_diagnostics(&loaded.model, &report.final_state) {
         println!(
             "heat: max T {:.2} K, enthalpy {:.6e} J, absorbed laser power {:.4e} W, evaporated {:.4e} W, radiated {:.4e} W, melted volume {:.4e}, melt pool depth {:.3e} m, width {:.3e} m, length {:.3e} m",
             h.max_temperature,
@@ -429,7 +429,10 @@ fn open_outputs(a: &OutputArgs, l: &run::Loaded, backend: &str) -> Result<Output
             backend,
             command: &command.join(" "),
         };
-        o.mcap = Some(McapSink::create(p, &l.model, &prov).map_err(|e| io_err("--out", e))?);
+        o.mcap = Some(
+            McapSink::create(p, &l.model, &prov, &spatter::diagnostics::topics(&l.model))
+                .map_err(|e| io_err("--out", e))?,
+        );
     }
     if let Some(d) = &a.vtk {
         o.vtk = Some(VtkSink::create(d).map_err(|e| io_err("--vtk", e))?);

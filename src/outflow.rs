@@ -141,7 +141,7 @@ impl Outflow {
 }
 
 fn side_name(m: &Model, st: &State, i: usize) -> &'static str {
-    let (a, side, _) = crate::watchdog::exit_face(m, st, i);
+    let (a, side, _) = m.exit_face(m.to_world(st.pos[i]));
     SIDE_NAMES[a][side]
 }
 
@@ -200,21 +200,43 @@ pub struct RemovalEvent {
     pub mass: f64,
 }
 
+/// The `/removed` events of a run not yet written (crate::diagnostics::REMOVED_TOPIC).
+#[derive(Debug, Default)]
+pub struct RemovalLog {
+    /// Ids whose removal is written; None until the first state (a resumed run's
+    /// earlier removals are in the earlier file).
+    reported: Option<HashSet<u32>>,
+}
+
+impl RemovalLog {
+    /// The particles that have left since the last state seen, by id; none at
+    /// the first state, which only records who is out already.
+    pub fn new_events(&mut self, m: &Model, st: &State) -> Vec<RemovalEvent> {
+        match self.reported.as_mut() {
+            Some(reported) => new_removals(m, st, reported),
+            None => {
+                self.reported = Some(removed_ids(st));
+                Vec::new()
+            }
+        }
+    }
+}
+
 /// The removals of `st` not yet in `reported` (which they are added to), by id.
-pub fn new_removals(m: &Model, st: &State, reported: &mut HashSet<u32>) -> Vec<RemovalEvent> {
+fn new_removals(m: &Model, st: &State, reported: &mut HashSet<u32>) -> Vec<RemovalEvent> {
     let mut out: Vec<RemovalEvent> = (st.active()..st.len())
         .filter(|&i| reported.insert(st.id[i]))
         .map(|i| {
-            let w = |a| crate::output::world_coord(m, st, i, a) as f64;
+            let [x, y, z] = m.to_world(st.pos[i]);
             let v = st.vel[i];
             RemovalEvent {
                 id: st.id[i],
                 phase: m.phases[st.phase[i] as usize].name.clone(),
                 time: st.pos[i][3] as f64,
                 side: side_name(m, st, i),
-                x: w(0),
-                y: w(1),
-                z: w(2),
+                x,
+                y,
+                z,
                 speed: ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt(),
                 mass: st.mass[i] as f64,
             }
@@ -225,7 +247,7 @@ pub fn new_removals(m: &Model, st: &State, reported: &mut HashSet<u32>) -> Vec<R
 }
 
 /// The ids already removed in `st` (a resumed run's earlier removals).
-pub fn removed_ids(st: &State) -> HashSet<u32> {
+fn removed_ids(st: &State) -> HashSet<u32> {
     st.id[st.active()..].iter().copied().collect()
 }
 

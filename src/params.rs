@@ -847,8 +847,7 @@ fn finite_or_max(v: f64) -> f32 {
     }
 }
 
-/// Stefan–Boltzmann constant (W m⁻² K⁻⁴).
-const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
+use crate::model::STEFAN_BOLTZMANN;
 
 /// One phase's row: flow material, wall motion, heat, melting and surface losses.
 fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {

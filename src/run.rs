@@ -1,18 +1,24 @@
 //! Loading a scene, choosing a backend and driving the step loop.
 
+mod observers;
+
+use observers::observe_all;
+pub use observers::{Findings, Moment, Observer};
+
 use crate::backend::cpu::CpuBackend;
 use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
 use crate::backend::{Backend, DeviceLost};
 use crate::checkpoint::{self, CheckpointSink};
-use crate::checks::{CheckResult, Checker};
+use crate::checks::CheckResult;
+use crate::diagnostics::{self, Leakage, BODIES_TOPIC, DIAGNOSTICS_TOPIC, REMOVED_TOPIC};
 use crate::error::{InputError, SpatterError};
 use crate::model::{self, EndCondition, Model};
-use crate::output::{self, mcap_out::McapSink, vtk::VtkSink};
+use crate::outflow::RemovalLog;
+use crate::output::{mcap_out::McapSink, vtk::VtkSink};
 use crate::params::Params;
 use crate::scene;
 use crate::setup;
 use crate::state::{dt_limit_name, State};
-use crate::track::Track;
 use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -50,9 +56,21 @@ pub fn load_str(label: &str, text: &str, sets: &[String]) -> Result<Loaded, Inpu
 
 /// A powder scene's grain of each particle id, from the initial state.
 fn attach_grains(model: &mut Model, initial: &State) {
-    let (origin, dim) = (model.origin, model.dim as usize);
+    if model.powder.is_none() {
+        return;
+    }
+    let particles: Vec<(u32, u32, [f64; 3])> = (0..initial.len())
+        .map(|i| {
+            (
+                initial.id[i],
+                initial.phase[i],
+                model.to_world(initial.pos[i]),
+            )
+        })
+        .collect();
+    let dim = model.dim as usize;
     if let Some(b) = model.powder.as_mut() {
-        b.attach(origin, dim, initial);
+        b.attach(dim, initial.len(), particles);
     }
 }
 
@@ -140,7 +158,7 @@ pub struct RunReport {
     /// The checkpoint written last, if any.
     pub last_checkpoint: Option<PathBuf>,
     /// Wall leakage over every state the run read back (issue 18).
-    pub leakage: watchdog::Leakage,
+    pub leakage: Leakage,
     /// The melt track of a laser scene (issue 16).
     pub track: Option<crate::track::TrackProfile>,
 }
@@ -163,33 +181,49 @@ pub struct Outputs {
     pub backend: String,
     last_diag_step: Option<u32>,
     last_checkpoint: Option<PathBuf>,
+    /// The `/removed` events written so far.
+    removals: RemovalLog,
 }
 
 impl Outputs {
+    /// A frame of `st` (MCAP `/particles` with its `/bodies` message, VTK).
     fn frame(&mut self, m: &Model, st: &State) -> Result<(), String> {
         if let Some(s) = self.mcap.as_mut() {
-            s.frame(m, st)?;
+            let written = s.frame(m, st)?;
+            if written && s.has(BODIES_TOPIC) {
+                let bodies = diagnostics::bodies_message(m, st);
+                s.message(BODIES_TOPIC, st.sim.time as f64, &bodies)?;
+            }
         }
         if let Some(v) = self.vtk.as_mut() {
             v.frame(m, st)?;
         }
         Ok(())
     }
-    /// `track` has observed `st` already (its depression under the beam).
-    fn diagnostics(&mut self, m: &Model, st: &State, track: Option<&Track>) -> Result<(), String> {
+    /// The `/removed` events since the last record, then the `/diagnostics`
+    /// record of `st` (once per step), with the figures of the observers, which
+    /// have seen `st` already.
+    fn diagnostics(
+        &mut self,
+        m: &Model,
+        st: &State,
+        observers: &[Box<dyn Observer>],
+    ) -> Result<(), String> {
         if self.last_diag_step == Some(st.sim.step) {
             return Ok(());
         }
         self.last_diag_step = Some(st.sim.step);
-        match self.mcap.as_mut() {
-            Some(s) => {
-                s.removals(m, st)?;
-                let mut d = output::diagnostics(m, st);
-                d.depression_depth = track.and_then(Track::depression_now);
-                s.diagnostics(&d)
-            }
-            None => Ok(()),
+        let Some(s) = self.mcap.as_mut() else {
+            return Ok(());
+        };
+        for e in self.removals.new_events(m, st) {
+            s.message(REMOVED_TOPIC, e.time, &e)?;
         }
+        let mut d = diagnostics::record(m, st);
+        for o in observers {
+            o.annotate(&mut d);
+        }
+        s.message(DIAGNOSTICS_TOPIC, d.time, &d)
     }
     fn checkpoint(&mut self, m: &Model, st: &State) -> Result<(), String> {
         if let Some(c) = self.checkpoints.as_mut() {
@@ -221,16 +255,17 @@ fn next_multiple(t: f64, interval: f64) -> f64 {
     ((t / interval + 1e-9).floor() + 1.0) * interval
 }
 
-/// Output schedule in simulated time.
-struct Schedule {
+/// When the next frame, diagnostics record and checkpoint are due, in simulated
+/// time.
+struct OutputSchedule {
     frame: f64,
     diag: f64,
     ckpt: f64,
 }
 
-impl Schedule {
-    fn new(m: &Model, t: f64, ckpt_every: Option<f64>) -> Schedule {
-        Schedule {
+impl OutputSchedule {
+    fn new(m: &Model, t: f64, ckpt_every: Option<f64>) -> OutputSchedule {
+        OutputSchedule {
             frame: next_multiple(t, m.output_interval),
             diag: next_multiple(t, m.diagnostics_interval),
             ckpt: ckpt_every.map_or(f64::INFINITY, |c| next_multiple(t, c)),
@@ -311,7 +346,7 @@ pub fn run(
 ) -> Result<RunReport, SpatterError> {
     let m = &l.model;
     let rt = SpatterError::Runtime;
-    let mut checker = Checker::new(m);
+    let mut observers = observers::list(m, opts);
     let start = Instant::now();
     if !opts.resumed {
         backend.prime();
@@ -323,18 +358,13 @@ pub fn run(
     let mut last_good = st.clone();
     let mut sim = st.sim;
     let start_step = sim.step as u64;
-    let mut sched = Schedule::new(m, sim.time as f64, out.checkpoint_every);
-    let mut track = Track::new(m, &st);
+    let mut sched = OutputSchedule::new(m, sim.time as f64, out.checkpoint_every);
+    observe_all(&mut observers, m, &st, Moment::Initial);
     out.frame(m, &st).map_err(rt)?;
-    out.diagnostics(m, &st, track.as_ref()).map_err(rt)?;
-    if let Some(c) = checker.as_mut() {
-        c.observe(m, &st);
-    }
+    out.diagnostics(m, &st, &observers).map_err(rt)?;
     let cap = chunk_cap(st.len());
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
-    let mut leakage = watchdog::leakage(m, &st);
-    let mut leak_warned = false;
     let mut end = RunEnd::Completed;
     while trip.is_none() {
         let t = sim.time as f64;
@@ -389,32 +419,18 @@ pub fn run(
         if trip.is_some() {
             continue;
         }
-        leakage.absorb(watchdog::leakage(m, &st));
-        if !leak_warned && leakage.beyond_half_dx > 0 && !opts.quiet {
-            leak_warned = true;
-            eprintln!(
-                "warning: fluid leaks into the walls: {}; the run stops at {} dx (watchdog.wall_penetration)",
-                leakage.summary(),
-                m.wall_stop_depth()
-            );
-        }
         last_good = st.clone();
-        if let Some(t) = track.as_mut() {
-            t.observe(m, &st);
-        }
+        observe_all(&mut observers, m, &st, Moment::Sample { frame: due.0 });
         if due.1 {
-            out.diagnostics(m, &st, track.as_ref()).map_err(rt)?;
+            out.diagnostics(m, &st, &observers).map_err(rt)?;
         }
         if due.0 {
             out.frame(m, &st).map_err(rt)?;
-            if let Some(c) = checker.as_mut() {
-                c.observe(m, &st);
-            }
         }
         if due.2 {
             out.checkpoint(m, &st).map_err(rt)?;
         }
-        sched = Schedule::new(m, t, out.checkpoint_every);
+        sched = OutputSchedule::new(m, t, out.checkpoint_every);
     }
     progress.finish();
     // The last chunk can end between two scans: the final state is scanned too, so
@@ -431,52 +447,42 @@ pub fn run(
         Some(first) => {
             let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
-            leakage.absorb(watchdog::leakage(m, &bad));
-            if let Some(t) = track.as_mut() {
-                t.observe(m, &bad);
-            }
+            observe_all(&mut observers, m, &bad, Moment::Unstable);
             out.frame(m, &bad).map_err(rt)?;
-            out.diagnostics(m, &bad, track.as_ref()).map_err(rt)?;
+            out.diagnostics(m, &bad, &observers).map_err(rt)?;
             out.checkpoint(m, &good).map_err(rt)?;
             end = RunEnd::Unstable(precise);
             bad
         }
         None => {
             let fin = fin.expect("the final state is read when nothing tripped");
-            leakage.absorb(watchdog::leakage(m, &fin));
-            if let Some(t) = track.as_mut() {
-                t.observe(m, &fin);
-            }
+            observe_all(&mut observers, m, &fin, Moment::Final);
             out.frame(m, &fin).map_err(rt)?;
-            out.diagnostics(m, &fin, track.as_ref()).map_err(rt)?;
+            out.diagnostics(m, &fin, &observers).map_err(rt)?;
             if out.checkpoint_every.is_some() || end == RunEnd::Interrupted {
                 out.checkpoint(m, &fin).map_err(rt)?;
             }
             fin
         }
     };
-    let track = track.map(|t| t.finish(m, &final_state));
-    if let (Some(sink), Some(profile)) = (out.mcap.as_mut(), track.as_ref()) {
-        sink.track(final_state.sim.time as f64, profile)
+    let mut found = Findings::default();
+    for o in observers {
+        o.finish(m, &final_state, &end, out, &mut found)
             .map_err(rt)?;
     }
     out.finish().map_err(rt)?;
     let wall_s = start.elapsed().as_secs_f64();
-    let check = match end {
-        RunEnd::Completed => checker.as_mut().map(|c| c.finish(m, &final_state)),
-        _ => None,
-    };
     Ok(RunReport {
         steps: final_state.sim.step as u64 - start_step,
         sim_time: final_state.sim.time as f64,
         wall_s,
         particles: final_state.len(),
-        check,
+        check: found.check,
         final_state,
         end,
         last_checkpoint: out.last_checkpoint.clone(),
-        leakage,
-        track,
+        leakage: found.leakage,
+        track: found.track,
     })
 }
 
@@ -613,7 +619,9 @@ mod tests {
             command: "test",
         };
         let mut out = Outputs {
-            mcap: Some(McapSink::create(&mcap, &l.model, &prov).unwrap()),
+            mcap: Some(
+                McapSink::create(&mcap, &l.model, &prov, &diagnostics::topics(&l.model)).unwrap(),
+            ),
             checkpoints: Some(CheckpointSink::create(&dir.join("ckpt").to_string_lossy()).unwrap()),
             ..Default::default()
         };

@@ -6,6 +6,7 @@
 
 use crate::error::InputError;
 use crate::model::{BodySource, Model};
+use crate::random::SplitMix;
 use crate::scene::{SceneFile, ShapeDef};
 use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT, NO_BODY};
 
@@ -195,20 +196,6 @@ fn validate_shapes(m: &Model, scene: &SceneFile) -> Result<Vec<usize>, InputErro
         phase_of.push(pi);
     }
     Ok(phase_of)
-}
-
-/// A small deterministic generator (SplitMix64) for the optional jitter; its output
-/// is fixed by the seed on every platform.
-pub(crate) struct SplitMix(pub(crate) u64);
-impl SplitMix {
-    pub(crate) fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 fn wall_phase_at(m: &Model, scene: &SceneFile, x: [f64; 3]) -> Option<usize> {

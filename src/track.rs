@@ -24,7 +24,6 @@
 //!   flying above the surface does not count as surface.
 
 use crate::model::Model;
-use crate::output::world_coord;
 use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
@@ -137,7 +136,7 @@ impl Track {
         for i in 0..st.active() {
             if condensed(m, st, i) {
                 if let Some(k) = t.slice(m, st, i) {
-                    let z = world_coord(m, st, i, t.up) as f64 + 0.5 * m.dx;
+                    let z = m.to_world(st.pos[i])[t.up] + 0.5 * m.dx;
                     t.initial_top[k] = t.initial_top[k].max(z);
                 }
             }
@@ -147,7 +146,7 @@ impl Track {
     }
 
     fn slice(&self, m: &Model, st: &State, i: usize) -> Option<usize> {
-        let x = world_coord(m, st, i, 0) as f64;
+        let x = m.to_world(st.pos[i])[0];
         let k = ((x - self.x0) / self.dx).floor();
         (k >= 0.0 && (k as usize) < self.initial_top.len()).then_some(k as usize)
     }
@@ -183,7 +182,8 @@ impl Track {
                 continue;
             };
             self.peak_t[k] = self.peak_t[k].max(t as f64);
-            let z = world_coord(m, st, i, self.up) as f64;
+            let x = m.to_world(st.pos[i]);
+            let z = x[self.up];
             // Melt in the pool: below the initial surface (a droplet flying or
             // lying above it is not the pool).
             if fl < 0.5 || z - 0.5 * self.dx >= self.initial_top[k] {
@@ -192,11 +192,10 @@ impl Track {
             self.lowest_melt[k] = self.lowest_melt[k].min(z);
             deepest = deepest.max(self.initial_top[k] - (z - 0.5 * self.dx));
             for (a, e) in extent.iter_mut().enumerate().take(m.dim as usize - 1) {
-                let c = world_coord(m, st, i, a) as f64;
-                *e = [e[0].min(c), e[1].max(c)];
+                *e = [e[0].min(x[a]), e[1].max(x[a])];
             }
             if m.dim == 3 {
-                let y = world_coord(m, st, i, 1) as f64;
+                let y = x[1];
                 self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
             }
         }
@@ -244,8 +243,9 @@ impl Track {
         let k = k as usize;
         let mut zs: Vec<f64> = (0..st.active())
             .filter(|&i| condensed(m, st, i) && self.slice(m, st, i) == Some(k))
-            .filter(|&i| m.dim < 3 || (world_coord(m, st, i, 1) as f64 - c[1]).abs() <= self.dx)
-            .map(|i| world_coord(m, st, i, self.up) as f64)
+            .map(|i| m.to_world(st.pos[i]))
+            .filter(|x| m.dim < 3 || (x[1] - c[1]).abs() <= self.dx)
+            .map(|x| x[self.up])
             .collect();
         let top = column_top(&mut zs, self.dx)? + 0.5 * self.dx;
         Some(self.initial_top[k] - top)
@@ -259,11 +259,12 @@ impl Track {
             if !condensed(m, st, i) {
                 continue;
             }
-            if m.dim == 3 && (world_coord(m, st, i, 1) as f64 - self.y_beam).abs() > self.dx {
+            let x = m.to_world(st.pos[i]);
+            if m.dim == 3 && (x[1] - self.y_beam).abs() > self.dx {
                 continue;
             }
             if let Some(k) = self.slice(m, st, i) {
-                columns[k].push(world_coord(m, st, i, self.up) as f64);
+                columns[k].push(x[self.up]);
             }
         }
         // Slices the melt reached at least half a row below the initial surface.
@@ -337,6 +338,30 @@ fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
 }
 
 impl TrackProfile {
+    /// The mean remelt depth of the first and of the last tenth of the melted
+    /// slices (where the scan starts and where it ends); None when nothing melted.
+    pub fn end_depths(&self) -> Option<(f64, f64)> {
+        let s = &self.slices;
+        if s.is_empty() {
+            return None;
+        }
+        let tenth = (s.len() / 10).max(1);
+        let mean_depth =
+            |part: &[Slice]| part.iter().map(|x| x.depth).sum::<f64>() / part.len() as f64;
+        Some((mean_depth(&s[..tenth]), mean_depth(&s[s.len() - tenth..])))
+    }
+
+    /// The mean of a slice figure over the slices where it is finite.
+    pub fn mean(&self, f: impl Fn(&Slice) -> f64) -> f64 {
+        let v: Vec<f64> = self
+            .slices
+            .iter()
+            .map(f)
+            .filter(|v| v.is_finite())
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    }
+
     /// Lines for the end of a run.
     pub fn summary(&self, dim: u32) -> Vec<String> {
         let p = &self.pool;
@@ -364,15 +389,12 @@ impl TrackProfile {
         }
         let stats = |f: &dyn Fn(&Slice) -> f64| {
             let v: Vec<f64> = s.iter().map(f).filter(|v| v.is_finite()).collect();
-            let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            let mean = self.mean(f);
             let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
             let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             format!("mean {mean:.3e} m (min {lo:.3e}, max {hi:.3e})")
         };
-        // The first and last tenth of the melted slices: where the scan starts and ends.
-        let tenth = (s.len() / 10).max(1);
-        let mean_depth =
-            |part: &[Slice]| part.iter().map(|x| x.depth).sum::<f64>() / part.len() as f64;
+        let (first_tenth, last_tenth) = self.end_depths().expect("slices melted");
         let mut track = format!(
             "track: {} slices of {:.1e} m melted, x from {:.4e} to {:.4e} m: remelt depth {}; first tenth {:.3e} m, last tenth {:.3e} m; surface height {} relative to the initial surface",
             s.len(),
@@ -380,8 +402,8 @@ impl TrackProfile {
             s[0].x,
             s[s.len() - 1].x,
             stats(&|x| x.depth),
-            mean_depth(&s[..tenth]),
-            mean_depth(&s[s.len() - tenth..]),
+            first_tenth,
+            last_tenth,
             stats(&|x| x.height),
         );
         if dim == 3 {

@@ -141,94 +141,11 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
     None
 }
 
-/// How far particle `i` is beyond each face of the domain: (axis, side, distance
-/// in m, the side is open) for every non-periodic face it is outside of.
-fn beyond_faces(m: &Model, st: &State, i: usize) -> Vec<(usize, usize, f64, bool)> {
-    let mut out = Vec::new();
-    for a in 0..m.dim as usize {
-        if m.periodic[a] {
-            continue;
-        }
-        let x = st.pos[i][a] as f64 + m.origin[a];
-        let (lo, hi) = (m.domain_lo[a], m.domain_hi[a]);
-        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
-            if beyond > 0.0 {
-                out.push((a, side, beyond, m.open_sides[a][side]));
-            }
-        }
-    }
-    out
-}
-
-/// Fluid leaking into the wall layers (issue 18): the deepest penetration behind a
-/// closed wall face and how many fluid particles are more than ½Δx behind one.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Leakage {
-    /// Deepest penetration behind a wall face, in Δx (0 with none).
-    pub deepest_dx: f64,
-    /// The particle (id) and face of the deepest penetration, and when.
-    pub particle: Option<u32>,
-    pub face: Option<(usize, usize)>,
-    pub time: f64,
-    /// Fluid particles more than ½Δx behind a wall face.
-    pub beyond_half_dx: u64,
-}
-
-impl Leakage {
-    /// Keep the deeper of two samples, and the larger count.
-    pub fn absorb(&mut self, other: Leakage) {
-        if other.deepest_dx > self.deepest_dx {
-            let count = self.beyond_half_dx;
-            *self = other;
-            self.beyond_half_dx = count;
-        }
-        self.beyond_half_dx = self.beyond_half_dx.max(other.beyond_half_dx);
-    }
-
-    pub fn summary(&self) -> String {
-        match (self.particle, self.face) {
-            (Some(id), Some((a, side))) => format!(
-                "deepest fluid penetration {:.2} dx (particle {id} behind the {} wall, t = {:.4e} s), at most {} particle(s) beyond 0.5 dx at once",
-                self.deepest_dx,
-                crate::scene::SIDE_NAMES[a][side],
-                self.time,
-                self.beyond_half_dx
-            ),
-            _ => "no fluid particle behind a wall face".into(),
-        }
-    }
-}
-
-/// The wall leakage of one state.
-pub fn leakage(m: &Model, st: &State) -> Leakage {
-    let mut l = Leakage {
-        time: st.sim.time as f64,
-        ..Leakage::default()
-    };
-    for i in 0..st.active() {
-        if !m.phases[st.phase[i] as usize].is_fluid() {
-            continue;
-        }
-        let deepest = beyond_faces(m, st, i)
-            .into_iter()
-            .filter(|f| !f.3)
-            .max_by(|x, y| x.2.total_cmp(&y.2));
-        if let Some((a, side, d, _)) = deepest {
-            let dx = d / m.dx;
-            l.beyond_half_dx += (dx > 0.5) as u64;
-            if dx > l.deepest_dx {
-                (l.deepest_dx, l.particle, l.face) = (dx, Some(st.id[i]), Some((a, side)));
-            }
-        }
-    }
-    l
-}
-
 /// A fluid particle still in the simulation deeper behind a wall face than the
 /// watchdog allows. (One beyond an open face has been removed by the step.)
 fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
     let depth = m.wall_stop_depth() * m.dx;
-    for (a, side, beyond, open) in beyond_faces(m, st, i) {
+    for (a, side, beyond, open) in m.beyond_faces(m.to_world(st.pos[i])) {
         if open || beyond <= depth {
             continue;
         }
@@ -256,33 +173,16 @@ fn wall_trip(
             m.wall_layers
         ),
     };
-    (AXES[a], st.pos[i][a] as f64 + m.origin[a], what)
-}
-
-/// The face a removed particle left through: the one it is farthest beyond
-/// (open or walled), by axis and side. The step decides removal in f32 against the
-/// same faces, so a particle within rounding of a face is still given that face.
-pub fn exit_face(m: &Model, st: &State, i: usize) -> (usize, usize, bool) {
-    let mut best = (0, 0, f64::NEG_INFINITY, false);
-    for a in (0..m.dim as usize).filter(|&a| !m.periodic[a]) {
-        let x = st.pos[i][a] as f64 + m.origin[a];
-        let (lo, hi) = m.keep_box(a);
-        let (lo, hi) = (lo + m.origin[a], hi + m.origin[a]);
-        for (side, beyond) in [(0, lo - x), (1, x - hi)] {
-            if beyond > best.2 {
-                best = (a, side, beyond, m.open_sides[a][side]);
-            }
-        }
-    }
-    (best.0, best.1, best.3)
+    (AXES[a], m.to_world(st.pos[i])[a], what)
 }
 
 /// A particle the step removed (issue 18): leaving through an open side is normal
 /// unless the scene's policy is "stop"; leaving behind a walled side means it went
 /// through every wall layer, which always stops the run.
 fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
-    let (a, side, open) = exit_face(m, st, i);
-    let x = st.pos[i][a] as f64 + m.origin[a];
+    let world = m.to_world(st.pos[i]);
+    let (a, side, open) = m.exit_face(world);
+    let x = world[a];
     if !open {
         let face = [m.domain_lo[a], m.domain_hi[a]][side];
         return Some(wall_trip(m, st, i, a, side, (x - face).abs()));
@@ -327,28 +227,6 @@ mod tests {
         assert_eq!(scan(&m, &st), None);
     }
 
-    /// Issue 18: penetration behind a closed face is measured in Δx, the deepest
-    /// kept with its particle and face, and counted beyond ½Δx.
-    #[test]
-    fn leakage_measures_depth_behind_wall_faces() {
-        let (m, mut st) = scene();
-        assert_eq!(leakage(&m, &st).deepest_dx, 0.0);
-        let f = fluid(&m, &st);
-        let x_lo = (m.domain_lo[0] - m.origin[0]) as f32;
-        st.pos[f[0]][0] = x_lo - 0.3 * m.dx as f32;
-        st.pos[f[1]][0] = x_lo - 0.7 * m.dx as f32;
-        let l = leakage(&m, &st);
-        assert!((l.deepest_dx - 0.7).abs() < 1e-3, "{l:?}");
-        assert_eq!(l.particle, Some(st.id[f[1]]));
-        assert_eq!(l.face, Some((0, 0)));
-        assert_eq!(l.beyond_half_dx, 1);
-        assert!(
-            l.summary().contains("behind the x_min wall"),
-            "{}",
-            l.summary()
-        );
-    }
-
     #[test]
     fn names_the_lowest_id_with_a_non_finite_value() {
         let (m, mut st) = scene();
@@ -366,7 +244,7 @@ mod tests {
         let (mut m, mut st) = scene();
         st.rho.iter_mut().for_each(|r| *r = 1000.0);
         let f = fluid(&m, &st);
-        let x_lo = m.domain_lo[0] - m.origin[0];
+        let x_lo = m.to_local(m.domain_lo)[0];
         // By default a leak into the wall layers is measured, not fatal; through
         // all of them (3 for the quintic) it stops the run.
         st.pos[f[0]][0] = (x_lo - 0.6 * m.dx) as f32;
@@ -389,7 +267,7 @@ mod tests {
             "{}",
             t.reason
         );
-        st.pos[f[0]][0] = (m.domain_lo[0] - m.origin[0] + 0.5 * m.dx) as f32;
+        st.pos[f[0]][0] = (x_lo + 0.5 * m.dx) as f32;
         st.rho[f[1]] = 5000.0;
         let t = scan(&m, &st).expect("density");
         assert_eq!(t.field, "density");

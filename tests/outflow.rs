@@ -4,8 +4,10 @@
 
 mod common;
 use common::{reader, scratch, spatter, text};
-use spatter::run::load;
-use std::collections::HashMap;
+use spatter::model::EndCondition;
+use spatter::outflow::{MassBalance, Outflow};
+use spatter::run::{load, RunEnd};
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 fn s(p: &Path) -> &str {
@@ -34,24 +36,24 @@ fn a_jet_leaves_through_the_open_side_at_its_ballistic_times() {
     let dir = scratch("outflow_jet");
     let mcap = dir.join("jet.mcap");
     let scene = common::scene("jet_outflow_2d");
-    let out = spatter(&["run", &scene, "--backend", "cpu", "--out", s(&mcap)]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
-
     let l = load(&scene, &[]).unwrap();
+    let mut out = common::mcap_outputs(&mcap, &l.model);
+    let r = common::run_with_outputs(&scene, &[], None, &mut out);
+    assert_eq!(r.end, RunEnd::Completed);
+
     let water = l.model.phase_index("water").unwrap() as u32;
     let x0: HashMap<u64, f64> = (0..l.state.len())
         .filter(|&i| l.state.phase[i] == water)
-        .map(|i| {
-            (
-                l.state.id[i] as u64,
-                l.state.pos[i][0] as f64 + l.model.origin[0],
-            )
-        })
+        .map(|i| (l.state.id[i] as u64, l.model.to_world(l.state.pos[i])[0]))
         .collect();
-    assert_eq!(x0.len(), 224);
+    let n_water = x0.len();
+    assert!(n_water > 0);
     let removed = json_messages(&mcap, "/removed");
-    assert_eq!(removed.len(), x0.len(), "every water particle left once");
+    let ids: HashSet<u64> = removed.iter().map(|r| r["id"].as_u64().unwrap()).collect();
+    assert!(
+        removed.len() == n_water && ids == x0.keys().copied().collect(),
+        "every water particle left once"
+    );
     let dt = 0.25 * 0.005 / (15.0 + 1.5);
     let mut worst: f64 = 0.0;
     for r in &removed {
@@ -76,34 +78,44 @@ fn a_jet_leaves_through_the_open_side_at_its_ballistic_times() {
     let m = l.state.mass[(0..l.state.len())
         .find(|&i| l.state.phase[i] == water)
         .unwrap()];
-    assert_eq!(last["removed"]["water"], 224, "{last}");
+    assert_eq!(last["removed"]["water"], n_water, "{last}");
     assert_eq!(last["particles"]["water"], 0, "{last}");
     assert_eq!(last["removed"]["wall"], 0, "{last}");
     let mass = last["removed_mass"]["water"].as_f64().unwrap();
-    assert!((mass - 224.0 * m as f64).abs() < 1e-9 * mass, "{last}");
-    let counts: Vec<u64> = diags
+    assert!(
+        (mass - n_water as f64 * m as f64).abs() < 1e-9 * mass,
+        "{last}"
+    );
+    let counts: Vec<usize> = diags
         .iter()
-        .map(|d| d["removed"]["water"].as_u64().unwrap())
+        .map(|d| d["removed"]["water"].as_u64().unwrap() as usize)
         .collect();
     assert!(counts.windows(2).all(|w| w[0] <= w[1]), "{counts:?}");
-    assert!(counts.iter().any(|&c| c > 0 && c < 224), "{counts:?}");
+    assert!(counts.iter().any(|&c| c > 0 && c < n_water), "{counts:?}");
     let sum = reader(&["summary", s(&mcap)]);
     let (o, e) = text(&sum);
     let sum: serde_json::Value = serde_json::from_str(&o).unwrap_or_else(|_| panic!("{o}{e}"));
-    let walls = l.state.len() as u64 - 224;
+    let walls = l.state.len() - n_water;
     assert_eq!(sum["particles_per_frame"][0], walls, "{sum}");
-    assert_eq!(sum["removed"], 224, "{sum}");
+    assert_eq!(sum["removed"], n_water, "{sum}");
 
-    // The run's summary: the count, and the mass balance exact.
-    assert!(
-        stdout.contains("outflow: 224 particle(s) left the domain: water 224")
-            && stdout.contains("224 through x_max"),
-        "{stdout}"
+    // The run's outflow: every water particle, through x_max; the mass balance
+    // exact.
+    let outflow = Outflow::of(&l.model, &r.final_state);
+    assert_eq!(
+        outflow.per_phase["water"].0 as usize,
+        n_water,
+        "{}",
+        outflow.summary()
     );
-    assert!(
-        stdout.contains("equal to the initial mass exactly"),
-        "{stdout}"
+    assert_eq!(
+        outflow.per_side,
+        [("x_max", n_water as u64)].into_iter().collect(),
+        "{}",
+        outflow.summary()
     );
+    let balance = MassBalance::of(&l.state, &r.final_state);
+    assert!(balance.exact(), "{}", balance.summary());
 }
 
 /// With domain.open_sides_policy = "stop" the first particle out ends the run
@@ -204,45 +216,23 @@ fn resume_across_removals_is_bit_identical_on_the_software_adapter() {
 /// that FAIL line, never the watchdog's 3.
 #[test]
 fn dam_break_3d_runs_on_to_one_second() {
-    let out = spatter(&[
-        "run",
-        &common::scene("dam_break_3d"),
-        "--backend",
-        "cpu",
-        "--until",
-        "1.0",
-    ]);
-    let (stdout, stderr) = text(&out);
-    let check_fails = stdout
-        .lines()
-        .any(|l| l.starts_with("check dam_break_front:") && l.ends_with("FAIL"));
-    let expected = if check_fails { 1 } else { 0 };
-    assert_eq!(out.status.code(), Some(expected), "{stdout}{stderr}");
-    assert!(!stderr.contains("unstable"), "{stderr}");
-    assert!(stdout.contains("simulated time: 1.0000"), "{stdout}");
-    let line = |start: &str| {
-        stdout
-            .lines()
-            .find(|l| l.starts_with(start))
-            .unwrap_or_else(|| panic!("no `{start}` line: {stdout}"))
-            .to_string()
-    };
-    let outflow = line("outflow: ");
+    let path = common::scene("dam_break_3d");
+    let (l, r) = common::run_loaded(&path, &[], Some(EndCondition::Time(1.0)));
+    assert_eq!(r.end, RunEnd::Completed, "not the watchdog's stop");
+    assert!(r.sim_time >= 1.0, "simulated time {}", r.sim_time);
+    if let Some(c) = &r.check {
+        println!("{}", c.line());
+    }
+    let outflow = Outflow::of(&l.model, &r.final_state);
     assert!(
-        outflow.contains("particle(s) left the domain: water") && outflow.contains("through z_max"),
-        "{outflow}"
+        outflow.per_phase.keys().eq(["water"]) && outflow.per_side.keys().copied().eq(["z_max"]),
+        "{}",
+        outflow.summary()
     );
-    assert!(line("mass: ").contains("equal to the initial mass exactly"));
-    let leak = line("wall leakage: deepest fluid penetration ");
-    let depth: f64 = leak
-        .trim_start_matches("wall leakage: deepest fluid penetration ")
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let balance = MassBalance::of(&l.state, &r.final_state);
+    assert!(balance.exact(), "{}", balance.summary());
     // Measured 0.51 Δx; one wall layer sits at 0.5 Δx, and the run stops at 3.
-    assert!(depth < 1.0, "{leak}");
+    assert!(r.leakage.deepest_dx < 1.0, "{}", r.leakage.summary());
 }
 
 /// simulation.barrier: one radius, in metres or in Δx, below h.
@@ -284,31 +274,11 @@ fn barrier_input_is_checked() {
 /// watchdog names one of them as having passed through every wall layer.
 #[test]
 fn a_time_step_200_times_the_limit_still_stops_within_a_few_steps() {
-    let out = spatter(&[
-        "run",
-        &common::scene("dam_break_2d"),
-        "--backend",
-        "cpu",
-        "--set",
-        "dt=6.25e-3",
-        "--set",
-        "dt_check=false",
-    ]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
-    let msg = stderr
-        .lines()
-        .find(|l| l.contains("unstable at step"))
-        .expect("diagnosis");
-    let step: u64 = msg
-        .split("unstable at step ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.parse().ok())
-        .expect("step number");
-    assert!(step <= 3, "{msg}");
-    assert!(
-        msg.contains(": particle ") && msg.contains(", field "),
-        "{msg}"
-    );
+    let sets = ["dt=6.25e-3", "dt_check=false"];
+    let r = common::run_path(&common::scene("dam_break_2d"), &sets, None);
+    let RunEnd::Unstable(trip) = r.end else {
+        panic!("the run went on: {:?}", r.end)
+    };
+    assert!(trip.step <= 3, "{}", trip.message());
+    assert!(trip.particle.is_some(), "{}", trip.message());
 }

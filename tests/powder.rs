@@ -6,9 +6,11 @@
 mod common;
 use common::{spatter, text};
 
+/// The coarse PBF bed's scene (a powder bed with a line melt).
+const SCENE: &str = "scenarios/pbf/powder_bed_line_melt_coarse_2d.toml";
+
 fn validate(sets: &[&str]) -> String {
-    let scene = "scenarios/pbf/powder_bed_line_melt_coarse_2d.toml";
-    let mut args = vec!["validate", scene];
+    let mut args = vec!["validate", SCENE];
     for s in sets {
         args.extend_from_slice(&["--set", s]);
     }
@@ -24,50 +26,46 @@ fn validate(sets: &[&str]) -> String {
 /// another seed another one.
 #[test]
 fn powder_bed_is_reported_and_filled() {
+    let load = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        spatter::run::load(SCENE, &sets).unwrap()
+    };
+    let l = load(&[]);
+    let bed = l.model.powder.as_ref().expect("a powder bed");
     let out = validate(&[]);
-    let line = out
-        .lines()
-        .find(|l| l.starts_with("powder: "))
-        .unwrap_or_else(|| panic!("{out}"));
-    let grains: usize = line["powder: ".len()..]
-        .split(' ')
-        .next()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("{line}"));
+    assert!(
+        out.lines().any(|line| line == bed.summary(2)),
+        "validate prints the bed: {out}"
+    );
     // 960 um of 16-32 um discs, two to three deep.
-    assert!((40..=120).contains(&grains), "{line}");
-    let fraction: f64 = line
-        .split("packing fraction ")
-        .nth(1)
-        .and_then(|v| v.split(' ').next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{line}"));
+    let grains = bed.grains.len();
+    assert!((40..=120).contains(&grains), "{}", bed.summary(2));
     // Discs poured into a box with walls and a levelled top: below the 0.82
     // of dense random discs, above a loose 0.5.
-    assert!((0.5..0.82).contains(&fraction), "{line}");
-    let plate = |out: &str| -> usize {
-        out.lines()
-            .find(|l| l.trim_start().starts_with("plate (Solid): "))
-            .and_then(|l| l.rsplit(' ').next())
-            .and_then(|n| n.parse().ok())
-            .unwrap_or_else(|| panic!("{out}"))
-    };
+    let fraction = bed.packing_fraction;
+    assert!((0.5..0.82).contains(&fraction), "{}", bed.summary(2));
     // The plate alone is 192 x 16 sites at dx = 5 um; the grains add about
     // their area over dx² = the packing fraction times the box's 192 x 8 sites
     // (measured 1011 against 989: a lattice fill of discs 3-6 sites across).
-    let fill = plate(&out) as f64 - (192 * 16) as f64;
+    let plate = l.model.phase_index("plate").unwrap() as u32;
+    let plate_particles = l.state.phase.iter().filter(|&&p| p == plate).count();
+    let fill = plate_particles as f64 - (192 * 16) as f64;
     let area = fraction * (192 * 8) as f64;
     assert!(
         (fill / area - 1.0).abs() < 0.05,
-        "{fill} sites for {area}: {out}"
+        "{fill} sites for {area}: {}",
+        bed.summary(2)
     );
-    assert_eq!(out, validate(&[]));
+    let again = load(&[]);
+    assert!(
+        again.model.powder.as_ref() == Some(bed),
+        "the same seed, the same bed"
+    );
+    let other = load(&["powder.seed=2"]);
     assert_ne!(
-        line,
-        validate(&["powder.seed=2"])
-            .lines()
-            .find(|l| l.starts_with("powder: "))
-            .unwrap()
+        other.model.powder.as_ref().unwrap().grains,
+        bed.grains,
+        "another seed, another bed"
     );
 }
 
@@ -101,37 +99,25 @@ fn grain_melting_is_tallied_and_survives_a_resume() {
     let dir = common::scratch("powder_tally");
     let scene = "scenarios/pbf/powder_bed_line_melt_coarse_2d.toml";
     let ck = dir.join("ck");
-    let out = spatter(&[
-        "run",
-        scene,
-        "--backend",
-        "cpu",
-        "--set",
-        "dx=1e-5",
-        "--set",
-        "end_time=2e-4",
-        "--checkpoint-every",
-        "1e-4",
-        "--checkpoint-dir",
-        ck.to_str().unwrap(),
-    ]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
-    let line = stdout
-        .lines()
-        .find(|l| l.starts_with("powder: of "))
-        .unwrap_or_else(|| panic!("{stdout}"));
-    let nums: Vec<usize> = line
-        .split(|c: char| !c.is_ascii_digit())
-        .filter_map(|w| w.parse().ok())
-        .take(4)
-        .collect();
-    let [grains, fully, partially, untouched] = nums[..] else {
-        panic!("{line}")
-    };
-    assert_eq!(fully + partially + untouched, grains, "{line}");
-    assert!(fully >= 1 && untouched >= 1, "{line}");
-    let sets = ["dx=1e-5".to_string(), "end_time=2e-4".to_string()];
+    let sets = ["dx=1e-5", "end_time=2e-4"];
+    let mut out = spatter::run::Outputs::default();
+    out.checkpoints =
+        Some(spatter::checkpoint::CheckpointSink::create(ck.to_str().unwrap()).unwrap());
+    out.checkpoint_every = Some(1e-4);
+    let r = common::run_with_outputs(scene, &sets, None, &mut out);
+    assert_eq!(r.end, spatter::run::RunEnd::Completed);
+    assert!(r.check.as_ref().is_none_or(|c| c.pass));
+    let g = r
+        .track
+        .and_then(|t| t.grains)
+        .expect("a melt track over a powder bed");
+    assert_eq!(
+        g.fully_molten + g.partially_molten + g.untouched,
+        g.grains,
+        "{g:?}"
+    );
+    assert!(g.fully_molten >= 1 && g.untouched >= 1, "{g:?}");
+    let sets = sets.map(String::from);
     let fresh = spatter::run::load(scene, &sets).unwrap();
     let ckpt = std::fs::read_dir(&ck)
         .unwrap()

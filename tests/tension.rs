@@ -1,40 +1,36 @@
-//! Issue 16: surface tension (CSF, F22 (24)–(26)) with gas particles.
+//! Issue 16: surface tension (CSF, F22 (24)–(26)) with gas particles. Each
+//! check's tolerance is stated and justified here and must be its scene file's;
+//! a test that holds a check to what the method gives today states that bound
+//! apart.
 
 mod common;
-use common::{spatter, text};
+use common::{assert_stated_tolerance, figure, run_check, scene, spatter, text};
+use spatter::checks::CheckResult;
 
-fn run_laplace(sets: &[&str]) -> (f64, String) {
-    run_laplace_scene("laplace_disc_2d", sets)
-}
+/// The Laplace pressure of the disc in gas: the issue's 3% at R = 20Δx (F22's
+/// form). Not met today (the ignored test says why).
+const LAPLACE_TOLERANCE: f64 = 0.03;
+/// The free-surface form (no gas): the issue's 5% at R = 20Δx. Not met today.
+const FREE_SURFACE_LAPLACE_TOLERANCE: f64 = 0.05;
+/// The 3D sphere in gas: the issue's 5% at R = 10Δx. Not met today.
+const LAPLACE_SPHERE_TOLERANCE: f64 = 0.05;
+/// The recoil momentum balance: the momentum gained within 2% of −∫ p_v A dt
+/// (the issue).
+const RECOIL_TOLERANCE: f64 = 0.02;
+/// A square drop relaxed to a disc: the outline's radius spread below 0.5Δx
+/// (the issue).
+const DROP_SHAPE_TOLERANCE: f64 = 0.5;
+/// Sessile drops: the contact angle within 5° of the static one (the issue).
+const CONTACT_ANGLE_TOLERANCE: f64 = 5.0;
+/// The thermocapillary channel: the interface velocity within 5% of the
+/// analytic amplitude at the finest resolution (the issue).
+const THERMOCAPILLARY_TOLERANCE: f64 = 0.05;
+/// Spurious currents, as the capillary number η|u|/σ: below 0.1 in every scene
+/// at rest (measured 2e-2 to 6.5e-2).
+const CAPILLARY_BOUND: f64 = 0.1;
 
-fn run_laplace_scene(name: &str, sets: &[&str]) -> (f64, String) {
-    run_check(name, sets, "check laplace:")
-}
-
-/// Run scene `name` on the CPU; the value of the check line starting `prefix`.
-fn run_check(name: &str, sets: &[&str], prefix: &str) -> (f64, String) {
-    let scene = common::scene(name);
-    let mut args = vec!["run", scene.as_str(), "--backend", "cpu"];
-    for s in sets {
-        args.extend_from_slice(&["--set", s]);
-    }
-    let out = spatter(&args);
-    let (stdout, stderr) = text(&out);
-    assert!(
-        matches!(out.status.code(), Some(0) | Some(1)),
-        "{stdout}{stderr}"
-    );
-    let line = stdout
-        .lines()
-        .find(|l| l.starts_with(prefix))
-        .unwrap_or_else(|| panic!("no check line: {stdout}"));
-    let error: f64 = line
-        .split(" = ")
-        .nth(1)
-        .and_then(|v| v.split(' ').next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{line}"));
-    (error, stdout)
+fn run_laplace(sets: &[&str]) -> CheckResult {
+    run_check("laplace_disc_2d", sets)
 }
 
 /// The issue's reference: Δp within 3% of σ/R at R = 20Δx (F22's form with gas).
@@ -48,8 +44,9 @@ fn run_check(name: &str, sets: &[&str], prefix: &str) -> (f64, String) {
 #[test]
 #[ignore = "Laplace pressure +9.3% at R = 20 dx, +11.4% at 40 dx (issue asks 3%): a ~10% bias from the one-row normals and curvature; see the note on issue 16"]
 fn laplace_pressure_within_3_percent_at_20_dx() {
-    let (error, out) = run_laplace(&[]);
-    assert!(error <= 0.03, "{out}");
+    assert_stated_tolerance(&scene("laplace_disc_2d"), LAPLACE_TOLERANCE);
+    let c = run_laplace(&[]);
+    assert!(c.pass && c.value <= LAPLACE_TOLERANCE, "{}", c.line());
 }
 
 /// What the method gives today, at the coarsest resolution (R = 10Δx, 14 s):
@@ -58,17 +55,13 @@ fn laplace_pressure_within_3_percent_at_20_dx() {
 /// and 4.8e-2 at 20Δx (falling with resolution, as the issue asks); bound 0.1.
 #[test]
 fn laplace_pressure_at_10_dx_as_measured() {
-    let (error, out) = run_laplace(&["dx=2e-3"]);
-    assert!(error <= 0.15, "{out}");
-    assert!(capillary_number(&out) < 0.1, "{out}");
-}
-
-fn capillary_number(out: &str) -> f64 {
-    out.split("capillary number eta |u| / sigma = ")
-        .nth(1)
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .expect("capillary number")
+    let c = run_laplace(&["dx=2e-3"]);
+    assert!(c.value <= 0.15, "{}", c.line());
+    assert!(
+        figure(&c, "capillary_number") < CAPILLARY_BOUND,
+        "{}",
+        c.line()
+    );
 }
 
 /// The issue's reference for the free-surface form (R18 §3.1.1–3.1.2, no gas):
@@ -86,8 +79,14 @@ fn capillary_number(out: &str) -> f64 {
 #[test]
 #[ignore = "free-surface Laplace +285% at R = 20 dx (issue asks 5%): the surface row compacts under summation density with a pressure floor; needs continuity density (delta-SPH); see the note on issue 16"]
 fn free_surface_laplace_within_5_percent_at_20_dx() {
-    let (error, out) = run_laplace_scene("laplace_free_disc_2d", &[]);
-    assert!(error <= 0.05, "{out}");
+    let name = "laplace_free_disc_2d";
+    assert_stated_tolerance(&scene(name), FREE_SURFACE_LAPLACE_TOLERANCE);
+    let c = run_check(name, &[]);
+    assert!(
+        c.pass && c.value <= FREE_SURFACE_LAPLACE_TOLERANCE,
+        "{}",
+        c.line()
+    );
 }
 
 /// What the free-surface form gives today at R = 10Δx (2 s): +211% measured; the
@@ -95,10 +94,16 @@ fn free_surface_laplace_within_5_percent_at_20_dx() {
 /// and nearly still: capillary number 2.0e-2 measured, bound 0.1.
 #[test]
 fn free_surface_laplace_at_10_dx_as_measured() {
-    let (error, out) = run_laplace_scene("laplace_free_disc_2d", &["dx=2e-3"]);
-    assert!(error <= 2.5, "{out}");
-    assert!(out.contains("no particle left the domain"), "{out}");
-    assert!(capillary_number(&out) < 0.1, "{out}");
+    let r = common::run_path(&scene("laplace_free_disc_2d"), &["dx=2e-3"], None);
+    assert_eq!(r.end, spatter::run::RunEnd::Completed);
+    assert_eq!(r.final_state.sim.removed, 0, "no particle left the domain");
+    let c = r.check.expect("a check");
+    assert!(c.value <= 2.5, "{}", c.line());
+    assert!(
+        figure(&c, "capillary_number") < CAPILLARY_BOUND,
+        "{}",
+        c.line()
+    );
 }
 
 /// A scene with gas particles must name its gas: the free-surface form is for
@@ -178,32 +183,13 @@ fn bad_surface_tension_input_names_the_key() {
 /// the recoil switched off (the pair forces cancel: 1e-14 of it measured).
 #[test]
 fn recoil_momentum_balance_and_nothing_without_it() {
-    let scene = common::scene("recoil_layer_2d");
-    let out = spatter(&["run", &scene, "--backend", "cpu"]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
-    assert!(
-        stdout.contains("check recoil_impulse:") && stdout.contains("PASS"),
-        "{stdout}"
-    );
-    let gained = |s: &str| -> f64 {
-        s.split("momentum gained ")
-            .nth(1)
-            .and_then(|v| v.split(' ').next())
-            .and_then(|v| v.parse().ok())
-            .unwrap_or_else(|| panic!("{s}"))
-    };
-    let with = gained(&stdout);
-    let off = spatter(&[
-        "run",
-        &scene,
-        "--backend",
-        "cpu",
-        "--set",
-        "materials.steel.evaporation.recoil=false",
-    ]);
-    let (stdout, _) = text(&off);
-    let without = gained(&stdout);
+    let name = "recoil_layer_2d";
+    assert_stated_tolerance(&scene(name), RECOIL_TOLERANCE);
+    let c = run_check(name, &[]);
+    assert!(c.pass && c.tolerance == RECOIL_TOLERANCE, "{}", c.line());
+    let with = figure(&c, "momentum_gained");
+    let off = run_check(name, &["materials.steel.evaporation.recoil=false"]);
+    let without = figure(&off, "momentum_gained");
     assert!(with < 0.0, "pushed down: {with}");
     assert!(
         without.abs() < 1e-9 * with.abs(),
@@ -302,14 +288,12 @@ fn solid_fluid_viscosity_input_and_limit() {
 /// falling with Δx, as the issue asks; see the note on issue 16).
 #[test]
 fn square_drop_relaxes_to_a_disc() {
-    let out = spatter(&["run", &common::scene("square_drop_2d"), "--backend", "cpu"]);
-    let (stdout, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    let c = common::assert_check_passes("square_drop_2d", DROP_SHAPE_TOLERANCE);
     assert!(
-        stdout.contains("check drop_shape:") && stdout.contains("PASS"),
-        "{stdout}"
+        figure(&c, "capillary_number") < CAPILLARY_BOUND,
+        "{}",
+        c.line()
     );
-    assert!(capillary_number(&stdout) < 0.1, "{stdout}");
 }
 
 /// The 3D sphere in gas: Δp within 5% of 2σ/R at R = 10Δx (the issue). Measured
@@ -317,22 +301,14 @@ fn square_drop_relaxes_to_a_disc() {
 #[test]
 #[ignore = "24 min on 2 cores; measured +11.3% at R = 10 dx (issue asks 5%), the 2D disc's ~10% bias; see the note on issue 16"]
 fn laplace_sphere_3d_within_5_percent_at_10_dx() {
-    let out = spatter(&[
-        "run",
-        &common::scene("laplace_sphere_3d"),
-        "--backend",
-        "cpu",
-    ]);
-    let (stdout, _) = text(&out);
-    assert!(
-        stdout.contains("check laplace:") && stdout.contains("PASS"),
-        "{stdout}"
-    );
+    common::assert_check_passes("laplace_sphere_3d", LAPLACE_SPHERE_TOLERANCE);
 }
 
-fn contact_angle(sets: &[&str]) -> (f64, String) {
-    let (error, out) = run_check("sessile_drop_2d", sets, "check contact_angle:");
-    (error, out)
+/// The sessile drop's check (angle error in degrees), held to the scene's
+/// tolerance, which must be `CONTACT_ANGLE_TOLERANCE`.
+fn contact_angle(sets: &[&str]) -> CheckResult {
+    assert_stated_tolerance(&scene("sessile_drop_2d"), CONTACT_ANGLE_TOLERANCE);
+    run_check("sessile_drop_2d", sets)
 }
 
 /// Sessile drops settle at their static contact angle within 5° (the issue),
@@ -340,10 +316,10 @@ fn contact_angle(sets: &[&str]) -> (f64, String) {
 /// slowly).
 #[test]
 fn sessile_drops_at_60_and_90_degrees_within_5() {
-    let (error, out) = contact_angle(&[]);
-    assert!(error <= 5.0, "{out}");
-    let (error, out) = contact_angle(&["surface_tension.contact_angle=60.0", "end_time=3.0"]);
-    assert!(error <= 5.0, "{out}");
+    let c = contact_angle(&[]);
+    assert!(c.value <= CONTACT_ANGLE_TOLERANCE, "{}", c.line());
+    let c = contact_angle(&["surface_tension.contact_angle=60.0", "end_time=3.0"]);
+    assert!(c.value <= CONTACT_ANGLE_TOLERANCE, "{}", c.line());
 }
 
 /// 120° within 5°: not met at R ≈ 10Δx, measured 106.6° after 3 s (109.3° at
@@ -353,8 +329,8 @@ fn sessile_drops_at_60_and_90_degrees_within_5() {
 #[test]
 #[ignore = "contact angle 106.6 deg for 120 (issue asks within 5 deg) at R = 10 dx; see the note on issue 16"]
 fn sessile_drop_at_120_degrees_within_5() {
-    let (error, out) = contact_angle(&["surface_tension.contact_angle=120.0", "end_time=3.0"]);
-    assert!(error <= 5.0, "{out}");
+    let c = contact_angle(&["surface_tension.contact_angle=120.0", "end_time=3.0"]);
+    assert!(c.value <= CONTACT_ANGLE_TOLERANCE, "{}", c.line());
 }
 
 /// Thermocapillary channel (Pendse & Esmaeeli 2010, scenarios/validation/
@@ -369,19 +345,20 @@ fn sessile_drop_at_120_degrees_within_5() {
 /// thermocapillary_2d` runs all three.
 #[test]
 fn thermocapillary_interface_velocity_within_5_percent_and_converging() {
-    let prefix = "check thermocapillary:";
-    let (coarse, out_coarse) = run_check("thermocapillary_2d", &[], prefix);
-    let (fine, out) = run_check("thermocapillary_2d", &["dx=1.25e-5"], prefix);
-    assert!(fine <= 0.05, "{out}");
-    assert!(fine < 0.75 * coarse, "{out_coarse}{out}");
+    let name = "thermocapillary_2d";
+    assert_stated_tolerance(&scene(name), THERMOCAPILLARY_TOLERANCE);
+    let coarse = run_check(name, &[]);
+    let fine = run_check(name, &["dx=1.25e-5"]);
+    assert!(fine.value <= THERMOCAPILLARY_TOLERANCE, "{}", fine.line());
+    assert!(
+        fine.value < 0.75 * coarse.value,
+        "{} then {}",
+        coarse.line(),
+        fine.line()
+    );
     // Steady: the band's amplitude moved less than 1% of U over the last quarter.
-    let drift: f64 = out
-        .lines()
-        .find_map(|l| l.split("over the last quarter ").nth(1))
-        .and_then(|v| v.split('%').next())
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or_else(|| panic!("{out}"));
-    assert!(drift < 1.0, "{out}");
+    let drift = figure(&fine, "drift");
+    assert!(drift < 0.01, "drift {drift} of U: {}", fine.line());
 }
 
 /// A wall heated as a cosine (`temperature_wave`) and the thermocapillary check's
@@ -425,15 +402,12 @@ fn contact_angle_per_phase() {
     let scene = common::scene("sessile_drop_2d");
     let line = |angle: &str| {
         let set = format!("surface_tension.contact_angle={angle}");
-        let (_, out) = run_check(
-            "sessile_drop_2d",
-            &[&set, "end_time=0.3"],
-            "check contact_angle:",
-        );
-        out.lines()
+        let c = run_check("sessile_drop_2d", &[&set, "end_time=0.3"]);
+        c.details
+            .iter()
             .find(|l| l.trim_start().starts_with("contact angle "))
-            .unwrap_or_else(|| panic!("{out}"))
-            .to_string()
+            .unwrap_or_else(|| panic!("no contact angle line: {:?}", c.details))
+            .clone()
     };
     assert_eq!(line("60.0"), line("{ substrate = 60.0 }"));
     for (set, key) in [

@@ -1,42 +1,35 @@
-//! Accuracy against reference solutions: each scene's [check] with the tolerance
-//! stated (and justified) in the scene file.
+//! Accuracy against reference solutions: each scene's [check], held to the
+//! tolerance stated and justified here, which must be the one its scene file
+//! states (`common::assert_stated_tolerance`).
 
 mod common;
-use spatter::run::{load, make_backend, run, BackendChoice, Outputs, RunOptions};
+use common::{assert_check_passes, assert_stated_tolerance, run_check, scene};
+use spatter::run::load;
 
-/// Runs a scene on the CPU with `--set` overrides and prints its check's lines.
-fn run_check(name: &str, sets: &[&str]) -> spatter::checks::CheckResult {
-    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let l = load(&common::scene(name), &sets).unwrap();
-    let mut b = make_backend(BackendChoice::Cpu, &l, false).unwrap();
-    let opts = RunOptions {
-        end: l.model.end,
-        quiet: true,
-        resumed: false,
-    };
-    let r = run(&l, b.as_mut(), &opts, &mut Outputs::default()).unwrap();
-    let c = r.check.expect("scene has a check");
-    for d in &c.details {
-        println!("{d}");
-    }
-    println!("{}", c.line());
-    c
-}
-
-fn check_passes(name: &str) -> f64 {
-    let c = run_check(name, &[]);
-    assert!(c.pass, "{}", c.line());
-    c.value
-}
+/// Poiseuille and Couette start-up flows: relative L2 error of the velocity
+/// profile against the series solution, 2% (issue 2).
+const PROFILE_TOLERANCE: f64 = 0.02;
+/// Hydrostatic columns: RMS error of the pressure deeper than one kernel support
+/// below the surface, relative to ρ g H, 2% (issue 2).
+const HYDROSTATIC_TOLERANCE: f64 = 0.02;
+/// Liquid under gas: the pressure jump across the interface relative to the
+/// liquid head ρ_l g H_l, 5% (issue 2); a particle across the interface fails
+/// the check outright.
+const TWO_LAYER_TOLERANCE: f64 = 0.05;
+/// The surge front against the experiments: within 10% (issue 2).
+const FRONT_TOLERANCE: f64 = 0.10;
+/// The compression check against g d / c² at the deepest particle: 5%, the
+/// start-up acoustic overshoot of the 0.3 s run (measured +2.9%).
+const COMPRESSION_TOLERANCE: f64 = 0.05;
 
 #[test]
 fn poiseuille_profile_within_2_percent() {
-    check_passes("poiseuille_2d");
+    assert_check_passes("poiseuille_2d", PROFILE_TOLERANCE);
 }
 
 #[test]
 fn couette_profile_within_2_percent() {
-    check_passes("couette_2d");
+    assert_check_passes("couette_2d", PROFILE_TOLERANCE);
 }
 
 /// The same start-up flow with the lid's particles translating along the periodic
@@ -45,23 +38,24 @@ fn couette_profile_within_2_percent() {
 /// it standing at the same velocity; tolerance as couette_2d).
 #[test]
 fn couette_with_a_translating_lid_within_2_percent() {
+    assert_stated_tolerance(&scene("couette_2d"), PROFILE_TOLERANCE);
     let c = run_check("couette_2d", &common::TRANSLATING_LID);
-    assert!(c.pass, "{}", c.line());
+    assert!(c.pass && c.tolerance == PROFILE_TOLERANCE, "{}", c.line());
 }
 
 #[test]
 fn hydrostatic_pressure_within_2_percent() {
-    check_passes("hydrostatic_2d");
+    assert_check_passes("hydrostatic_2d", HYDROSTATIC_TOLERANCE);
 }
 
 #[test]
 fn hydrostatic_3d_pressure_within_2_percent() {
-    check_passes("hydrostatic_3d");
+    assert_check_passes("hydrostatic_3d", HYDROSTATIC_TOLERANCE);
 }
 
 #[test]
 fn two_layer_no_crossing_and_continuous_pressure() {
-    check_passes("two_layer_2d");
+    assert_check_passes("two_layer_2d", TWO_LAYER_TOLERANCE);
 }
 
 /// The hydrostatic start (`simulation.initial_pressure = "hydrostatic"`) stacks the
@@ -72,16 +66,16 @@ fn two_layer_no_crossing_and_continuous_pressure() {
 /// 1e-4 relative is f32 rounding of the summed weights.
 #[test]
 fn hydrostatic_start_stacks_the_layers() {
-    let l = load(&common::scene("two_layer_2d"), &[]).unwrap();
+    let l = load(&scene("two_layer_2d"), &[]).unwrap();
     let (m, st) = (&l.model, &l.state);
     let g = 9.81;
-    let mut checked = 0;
+    let mut layers_seen = [false; 2];
     for i in 0..st.pos.len() {
         let ph = &m.phases[st.phase[i] as usize];
         if !ph.is_fluid() {
             continue;
         }
-        let y = st.pos[i][1] as f64 + m.origin[1];
+        let y = m.to_world(st.pos[i])[1];
         let (rho_l, rho_g) = (1000.0, 10.0);
         let expected = if y > 0.1 {
             rho_g * g * (0.2 - y)
@@ -96,9 +90,9 @@ fn hydrostatic_start_stacks_the_layers() {
         let c2 = ph.sound_speed * ph.sound_speed;
         let mass = ph.mass * (1.0 + expected / (ph.rho0 * c2));
         assert!((st.mass[i] as f64 - mass).abs() <= 1e-6 * mass);
-        checked += 1;
+        layers_seen[(y > 0.1) as usize] = true;
     }
-    assert_eq!(checked, 20 * 40);
+    assert_eq!(layers_seen, [true; 2], "both layers are stacked");
 }
 
 /// Density ratio 1000, issue 2's upper bound, without the interface viscosity:
@@ -145,7 +139,7 @@ fn two_layer_check_fails_when_liquid_enters_the_gas() {
 
 #[test]
 fn two_layer_ratio_1000_with_interface_viscosity_within_5_percent() {
-    check_passes("two_layer_ratio1000_2d");
+    assert_check_passes("two_layer_ratio1000_2d", TWO_LAYER_TOLERANCE);
 }
 
 /// Fails today: the front runs ahead of Koshizuka & Oka (1996) by up to 20.4% at
@@ -160,7 +154,7 @@ fn two_layer_ratio_1000_with_interface_viscosity_within_5_percent() {
 #[test]
 #[ignore = "surge front 20.4% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
 fn dam_break_front_within_10_percent() {
-    check_passes("dam_break_2d");
+    assert_check_passes("dam_break_2d", FRONT_TOLERANCE);
 }
 
 /// The front's motion once it has started, against both experiments. The run
@@ -175,22 +169,16 @@ fn dam_break_front_within_10_percent() {
 /// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
 /// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse, with its
 /// wall barrier): 7.5% at ΔT = 0.150, 2.5% at ΔT = 0.185.
-fn front_matches_after_release_delay(scene: &str) {
-    let c = run_check(scene, &[]);
-    let figure = |key: String| {
-        c.figures
-            .iter()
-            .find(|f| f.0 == key)
-            .map(|f| f.1)
-            .unwrap_or_else(|| panic!("no figure {key}"))
-    };
+fn front_matches_after_release_delay(name: &str) {
+    assert_stated_tolerance(&scene(name), FRONT_TOLERANCE);
+    let c = run_check(name, &[]);
     for exp in ["koshizuka_oka", "martin_moyce"] {
-        let delay = figure(format!("release_delay_{exp}"));
-        let error = figure(format!("release_delay_error_{exp}"));
+        let delay = common::figure(&c, &format!("release_delay_{exp}"));
+        let error = common::figure(&c, &format!("release_delay_error_{exp}"));
         // A best fit inside the window, not at its edge: the run leads the data.
         assert!(delay > 0.0 && delay < 0.5, "{exp}: delay {delay}");
         assert!(
-            error <= 0.10,
+            error <= FRONT_TOLERANCE,
             "{exp}: {:.1}% at delay {delay}",
             100.0 * error
         );
@@ -216,8 +204,9 @@ fn run_cli_prints_check_and_throughput_lines() {
         .lines()
         .find(|l| l.starts_with("check poiseuille:"))
         .expect("check line");
+    let tolerance = format!("(tolerance {PROFILE_TOLERANCE:.4e})");
     assert!(
-        check.ends_with("PASS") && check.contains("(tolerance 2.0000e-2)"),
+        check.ends_with("PASS") && check.contains(&tolerance),
         "{check}"
     );
     assert!(
@@ -330,10 +319,11 @@ fn gpu_run_with_profile_reports_passes() {
 
 /// The compression check on a column started at rest in equilibrium: the deepest
 /// particle (centre Δx/2 above the floor, 0.395 m under the surface) carries
-/// ρ/ρ0 − 1 = g d / c² = 9.81 · 0.395 / 30² = 4.305e-3 (linear EOS, p = ρ0 g d).
-/// Tolerance 5%: the start-up acoustic overshoot of the 0.3 s run, measured at +2.9%.
+/// ρ/ρ0 − 1 = g d / c² = 9.81 · 0.395 / 30² = 4.305e-3 (linear EOS, p = ρ0 g d),
+/// within `COMPRESSION_TOLERANCE`; the check itself passes the scene's 2%.
 #[test]
 fn compression_check_matches_hydrostatic_column() {
+    assert_stated_tolerance(&scene("hydrostatic_2d"), HYDROSTATIC_TOLERANCE);
     let c = run_check(
         "hydrostatic_2d",
         &[
@@ -344,7 +334,11 @@ fn compression_check_matches_hydrostatic_column() {
     );
     let exact = 9.81 * 0.395 / (30.0 * 30.0);
     let err = (c.value - exact).abs() / exact;
-    assert!(err < 0.05, "compression {} vs g d / c² = {exact}", c.value);
+    assert!(
+        err < COMPRESSION_TOLERANCE,
+        "compression {} vs g d / c² = {exact}",
+        c.value
+    );
     assert!(c.pass, "{}", c.line());
 }
 
@@ -359,5 +353,6 @@ fn peer_bench_scene_has_the_peer_particle_count() {
     let o = common::spatter(&["validate", &path]);
     let (out, err) = common::text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}{err}");
-    assert!(out.contains("water (Liquid): 103823"), "{out}");
+    let peer = format!("water (Liquid): {}", 47u64.pow(3));
+    assert!(out.contains(&peer), "{out}");
 }

@@ -3,7 +3,7 @@
 //! periodic and open sides, kernel, viscosity and jitter — all within the ranges a
 //! scene file accepts. The same seed gives the same TOML text on every machine.
 
-use crate::setup::SplitMix;
+use crate::random::SplitMix;
 use std::fmt::Write as _;
 
 pub struct RandomScene {

@@ -426,6 +426,7 @@ fn outputs(dir: &std::path::Path, l: &Loaded, backend: &str) -> Result<Outputs, 
         &dir.join("run.mcap").to_string_lossy(),
         &l.model,
         &prov,
+        &crate::diagnostics::topics(&l.model),
     )?);
     o.checkpoints = Some(CheckpointSink::create(&dir.join("ckpt").to_string_lossy())?);
     Ok(o)

@@ -198,7 +198,7 @@ impl super::Check for Flotation {
             return (metric, f64::NAN, vec!["needs a rigid body".into()]).into();
         };
         let up = m.dim as usize - 1;
-        let world = |i: usize, a: usize| st.pos[i][a] as f64 + m.origin[a];
+        let world = |i: usize, a: usize| m.to_world(st.pos[i])[a];
         let members: Vec<usize> = (0..st.active())
             .filter(|&i| st.body[st.id[i] as usize] == 0)
             .collect();
@@ -527,7 +527,7 @@ impl super::Check for Settling {
         let (t0, y0) = self.samples[0];
         let (t1, y1) = *self.samples.last().unwrap();
         let u = (y0 - y1) / (t1 - t0);
-        let centre = b.x[0] as f64 + m.origin[0];
+        let centre = m.to_world(b.x)[0];
         let details = vec![format!(
             "settling: disc area radius a = {a:.5e} m, k = a/h = {k:.4}, Faxén lambda = {lambda:.4}, Re = {:.3e}; U = {u:.5e} m/s (mean fall speed from t = {t0:.3e} to {t1:.3e} s, {:.3} dx) against U_Faxen = {u_ref:.5e} m/s; the disc's centre {:.3} dx off the channel's midline",
             rho_f * u * 2.0 * a / mu,
@@ -538,7 +538,7 @@ impl super::Check for Settling {
             metric,
             value: (u - u_ref).abs() / u_ref,
             details,
-            figures: vec![("u".into(), u), ("u_ref".into(), u_ref)],
+            figures: vec![("u".into(), u), ("u_ref".into(), u_ref), ("k".into(), k)],
         }
     }
 }

@@ -13,7 +13,7 @@ fn conducting(m: &Model, st: &State) -> Vec<(f64, f64, usize)> {
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
         .map(|i| {
             (
-                st.pos[i][ax] as f64 + m.origin[ax],
+                m.to_world(st.pos[i])[ax],
                 st.heat[i][1] as f64,
                 st.phase[i] as usize,
             )
@@ -30,7 +30,7 @@ fn wall_temperatures(m: &Model, st: &State) -> (Option<f64>, Option<f64>) {
         let Some(th) = ph.thermal.filter(|_| !ph.conducts()) else {
             continue;
         };
-        let x = st.pos[i][ax] as f64 + m.origin[ax];
+        let x = m.to_world(st.pos[i])[ax];
         if x < m.domain_lo[ax] {
             lo = Some(th.temperature);
         } else if x > m.domain_hi[ax] {
@@ -128,7 +128,9 @@ pub fn two_materials(m: &Model, st: &State, interface: f64) -> (String, f64, Vec
 pub fn total_enthalpy(m: &Model, st: &State) -> f64 {
     (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
-        .map(|i| st.mass[i] as f64 * crate::output::absolute_enthalpy(m, st, i))
+        .map(|i| {
+            st.mass[i] as f64 * m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0])
+        })
         .sum()
 }
 
@@ -334,7 +336,8 @@ pub fn rosenthal(m: &Model, st: &State) -> (String, f64, Vec<String>) {
     let pts: Vec<(f64, f64, f64, f64, usize)> = (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].conducts())
         .map(|i| {
-            let x = |a: usize| st.pos[i][a] as f64 + m.origin[a];
+            let world = m.to_world(st.pos[i]);
+            let x = |a: usize| world[a];
             let lateral = if m.dim == 3 { x(1) - beam[1] } else { 0.0 };
             (
                 x(0) - beam[0],
@@ -474,7 +477,7 @@ impl Check for LaserEnergy {
     fn observe(&mut self, m: &Model, st: &State) {
         let t = st.sim.time as f64;
         self.initial.get_or_insert_with(|| total_enthalpy(m, st));
-        let (evap, rad) = crate::output::surface_loss_power(m, st);
+        let (evap, rad) = crate::diagnostics::surface_loss_power(m, st);
         if self.losses.last().is_none_or(|l| l.0 < t) {
             self.losses.push((t, evap + rad));
         }

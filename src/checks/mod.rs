@@ -163,14 +163,9 @@ pub(super) struct P {
 /// The particles still in the simulation (those that left are not sampled).
 pub(super) fn particles<'a>(m: &'a Model, st: &'a State) -> impl Iterator<Item = P> + 'a {
     (0..st.active()).map(move |i| {
-        let x = st.pos[i];
         let v = st.vel[i];
         P {
-            x: [
-                x[0] as f64 + m.origin[0],
-                x[1] as f64 + m.origin[1],
-                x[2] as f64 + m.origin[2],
-            ],
+            x: m.to_world(st.pos[i]),
             v: [v[0] as f64, v[1] as f64, v[2] as f64],
             p: st.press[i] as f64,
             kind: m.phases[st.phase[i] as usize].kind,

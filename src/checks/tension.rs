@@ -315,10 +315,8 @@ fn floor_angle(m: &Model, st: &State) -> Option<f64> {
         .map(|p| p.x)
         .min_by(|a, b| a[1].total_cmp(&b[1]))?;
     let d2 = |i: usize| {
-        let x = st.pos[i];
-        (0..2)
-            .map(|a| (x[a] as f64 + m.origin[a] - lowest[a]).powi(2))
-            .sum::<f64>()
+        let x = m.to_world(st.pos[i]);
+        (0..2).map(|a| (x[a] - lowest[a]).powi(2)).sum::<f64>()
     };
     (0..st.active())
         .filter(|&i| angles[st.phase[i] as usize].is_some())

@@ -131,7 +131,7 @@ fn crossing(m: &Model, st: &State) -> Crossing {
             worst.count += 1;
         }
         if c < worst.colour {
-            let x = std::array::from_fn(|a| st.pos[i][a] as f64 + m.origin[a]);
+            let x = m.to_world(st.pos[i]);
             (worst.colour, worst.id, worst.kind, worst.x) = (c, st.id[i], kind_of(m, st, i), x);
         }
     }

@@ -273,3 +273,43 @@ fn check_side(
     }
     Ok(())
 }
+
+impl Model {
+    /// How far the world point `x` is beyond each face of the domain: (axis,
+    /// side, distance in m, the side is open) for every non-periodic face it is
+    /// outside of. The watchdog and the wall-leakage tally measure penetration
+    /// with it.
+    pub fn beyond_faces(&self, x: [f64; 3]) -> Vec<(usize, usize, f64, bool)> {
+        let mut out = Vec::new();
+        for a in 0..self.dim as usize {
+            if self.periodic[a] {
+                continue;
+            }
+            let (lo, hi) = (self.domain_lo[a], self.domain_hi[a]);
+            for (side, beyond) in [(0, lo - x[a]), (1, x[a] - hi)] {
+                if beyond > 0.0 {
+                    out.push((a, side, beyond, self.open_sides[a][side]));
+                }
+            }
+        }
+        out
+    }
+
+    /// The face a removed particle at world point `x` left through: the one of
+    /// the keep box (`keep_box`) it is farthest beyond, open or walled, as (axis,
+    /// side, the side is open). The step decides removal in f32 against the same
+    /// faces, so a particle within rounding of a face is still given that face.
+    pub fn exit_face(&self, x: [f64; 3]) -> (usize, usize, bool) {
+        let mut best = (0, 0, f64::NEG_INFINITY, false);
+        for a in (0..self.dim as usize).filter(|&a| !self.periodic[a]) {
+            let (lo, hi) = self.keep_box(a);
+            let (lo, hi) = (lo + self.origin[a], hi + self.origin[a]);
+            for (side, beyond) in [(0, lo - x[a]), (1, x[a] - hi)] {
+                if beyond > best.2 {
+                    best = (a, side, beyond, self.open_sides[a][side]);
+                }
+            }
+        }
+        (best.0, best.1, best.3)
+    }
+}

@@ -21,6 +21,7 @@ use domain::{
 pub use domain::{lattice_sites, LATTICE_TOLERANCE};
 use phases::{artificial_nu, interface_viscosity_nu, phase_table, solid_fluid_viscosity};
 use thermal::thermal_table;
+pub use thermal::STEFAN_BOLTZMANN;
 
 use crate::error::InputError;
 use crate::scene::{
@@ -268,6 +269,20 @@ impl Model {
             x[1] - self.origin[1],
             x[2] - self.origin[2],
         ]
+    }
+    /// World (absolute) coordinates of a stored position (a particle's `pos`, a
+    /// body's `x`): the grid-relative f32 value plus the grid origin, summed in
+    /// f64, so no figure loses the position's bits to a second rounding; 0 on the
+    /// axes beyond the scene's dimension. Every host-side reader goes through it
+    /// (frames round it once to f32, `output::position_channels`).
+    pub fn to_world(&self, p: [f32; 4]) -> [f64; 3] {
+        std::array::from_fn(|a| {
+            if a < self.dim as usize {
+                p[a] as f64 + self.origin[a]
+            } else {
+                0.0
+            }
+        })
     }
 }
 

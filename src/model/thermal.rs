@@ -1,7 +1,33 @@
 //! Heat: each phase's thermal material (conduction, melting band, evaporation,
-//! radiation) from the scene's heat keys.
+//! radiation) from the scene's heat keys, and the host-side heat physics the
+//! diagnostics and checks evaluate in f64 (absolute enthalpy, radiated flux).
 
 use super::*;
+
+/// Stefan–Boltzmann constant σ (W m⁻² K⁻⁴; CODATA 2018, exact in SI). The one
+/// definition: the parameter block's ε σ (params.rs) and the host's radiated
+/// flux both read it.
+pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
+
+impl PhaseInfo {
+    /// Specific enthalpy h(T) (J/kg) of a particle of this phase whose stored
+    /// enthalpy (`heat.x`, relative to the phase's reference enthalpy, J/kg) is
+    /// `stored`; 0 for a phase that does not conduct.
+    pub fn absolute_enthalpy(&self, stored: f32) -> f64 {
+        if !self.conducts() {
+            return 0.0; // a Dirichlet wall's heat.x is its fixed temperature
+        }
+        stored as f64 + self.thermal.map_or(0.0, |t| t.reference_enthalpy())
+    }
+}
+
+impl Thermal {
+    /// Heat flux radiated by a free surface at temperature `t` into surroundings at
+    /// `ambient` (K): ε σ (T⁴ − T_a⁴), W/m².
+    pub fn radiated_flux(&self, t: f64, ambient: f64) -> f64 {
+        self.emissivity * STEFAN_BOLTZMANN * (t.powi(4) - ambient.powi(4))
+    }
+}
 
 /// Heat properties: a scene is a heat scene when any phase has a temperature.
 /// Then every non-wall phase needs a temperature, conductivity and heat capacity.

@@ -194,3 +194,133 @@ velocity = [0.0, -0.3]
 [run]
 steps = 200
 "#;
+
+/// `[check] tolerance` as scene file `path` states it (read from the TOML here,
+/// not through the simulator's scene parser).
+pub fn file_tolerance(path: &str) -> f64 {
+    file_check_value(path, "tolerance")
+}
+
+/// A number of scene file `path`'s `[check]` section, as the file states it.
+pub fn file_check_value(path: &str, key: &str) -> f64 {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let doc: toml::Table = toml::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"));
+    doc.get("check")
+        .and_then(|c| c.get(key))
+        .and_then(|v| v.as_float())
+        .unwrap_or_else(|| panic!("{path}: no [check] {key}"))
+}
+
+/// The tolerance a test states (and justifies) for the check of scene file
+/// `path` is the one the file states: a scene edit that loosens or tightens its
+/// check fails the test that gives the reason for it.
+pub fn assert_stated_tolerance(path: &str, stated: f64) {
+    let file = file_tolerance(path);
+    assert_eq!(
+        file, stated,
+        "{path}: [check] tolerance = {file}, the test states {stated}"
+    );
+}
+
+/// Run scene file `path` with `--set`-style overrides on the CPU, through the
+/// library, to `end` (None: the scene's own end); no outputs.
+pub fn run_path(
+    path: &str,
+    sets: &[&str],
+    end: Option<spatter::model::EndCondition>,
+) -> spatter::run::RunReport {
+    run_with_outputs(path, sets, end, &mut spatter::run::Outputs::default())
+}
+
+/// `run_path` writing to `out`.
+pub fn run_with_outputs(
+    path: &str,
+    sets: &[&str],
+    end: Option<spatter::model::EndCondition>,
+    out: &mut spatter::run::Outputs,
+) -> spatter::run::RunReport {
+    run_loaded_with_outputs(path, sets, end, out).1
+}
+
+/// `run_path`, with the scene it loaded.
+pub fn run_loaded(
+    path: &str,
+    sets: &[&str],
+    end: Option<spatter::model::EndCondition>,
+) -> (spatter::run::Loaded, spatter::run::RunReport) {
+    run_loaded_with_outputs(path, sets, end, &mut spatter::run::Outputs::default())
+}
+
+fn run_loaded_with_outputs(
+    path: &str,
+    sets: &[&str],
+    end: Option<spatter::model::EndCondition>,
+    out: &mut spatter::run::Outputs,
+) -> (spatter::run::Loaded, spatter::run::RunReport) {
+    use spatter::run::{load, make_backend, run, BackendChoice, RunOptions};
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let l = load(path, &sets).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut b = make_backend(BackendChoice::Cpu, &l, false).unwrap();
+    let opts = RunOptions {
+        end: end.unwrap_or(l.model.end),
+        quiet: true,
+        resumed: false,
+    };
+    let r = run(&l, b.as_mut(), &opts, out).unwrap_or_else(|e| panic!("{path}: {e}"));
+    (l, r)
+}
+
+/// Outputs that write an MCAP stream to `path` (as `spatter run --out` does).
+pub fn mcap_outputs(path: &std::path::Path, m: &spatter::model::Model) -> spatter::run::Outputs {
+    use spatter::output::mcap_out::{McapSink, Provenance};
+    let prov = Provenance {
+        backend: "cpu",
+        command: "cargo test",
+    };
+    let topics = spatter::diagnostics::topics(m);
+    let sink = McapSink::create(path.to_str().unwrap(), m, &prov, &topics).unwrap();
+    let mut out = spatter::run::Outputs::default();
+    out.mcap = Some(sink);
+    out.backend = "cpu".into();
+    out
+}
+
+/// The check of a run of validation scene `name` (with overrides) to its end on
+/// the CPU; the run must complete. Prints the check's lines.
+pub fn run_check(name: &str, sets: &[&str]) -> spatter::checks::CheckResult {
+    let r = run_path(&scene(name), sets, None);
+    assert_eq!(r.end, spatter::run::RunEnd::Completed, "{name} {sets:?}");
+    let c = r.check.expect("the scene has a check");
+    print_check(name, sets, &c);
+    c
+}
+
+pub fn print_check(name: &str, sets: &[&str], c: &spatter::checks::CheckResult) {
+    println!("{name} {sets:?}");
+    for d in &c.details {
+        println!("{d}");
+    }
+    println!("{}", c.line());
+}
+
+/// The check of validation scene `name` run as its file says, with the
+/// tolerance the test states (which must be the file's); it must pass.
+pub fn assert_check_passes(name: &str, stated: f64) -> spatter::checks::CheckResult {
+    assert_stated_tolerance(&scene(name), stated);
+    let c = run_check(name, &[]);
+    assert_eq!(
+        c.tolerance, stated,
+        "the run held {name} to another tolerance"
+    );
+    assert!(c.pass, "{}", c.line());
+    c
+}
+
+/// A named figure of a check result.
+pub fn figure(c: &spatter::checks::CheckResult, name: &str) -> f64 {
+    c.figures
+        .iter()
+        .find(|f| f.0 == name)
+        .map(|f| f.1)
+        .unwrap_or_else(|| panic!("no figure {name} in {}: {:?}", c.line(), c.figures))
+}

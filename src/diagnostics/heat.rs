@@ -1,0 +1,104 @@
+//! Heat figures of a `/diagnostics` record (issue 4): the hottest particle, the
+//! enthalpy, the laser's absorbed power, the losses through free surfaces and the
+//! melt pool.
+
+use crate::model::Model;
+use crate::scene::PhaseKind;
+use crate::state::State;
+use serde::Serialize;
+
+/// Heat diagnostics (issue 4). Melt pool: particles with liquid fraction ≥ ½
+/// among the liquid and solid ones; depth below the top of the condensed
+/// material, width across and length along x (3D: width along y).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct HeatDiagnostics {
+    pub max_temperature: f64,
+    /// J (per metre of depth in 2D), Σ m h over conducting particles.
+    pub total_enthalpy: f64,
+    /// ζ P(t) of the laser (W; W/m in 2D); 0 without a laser.
+    pub absorbed_laser_power: f64,
+    /// Σ f_l V over liquid and solid particles (m³; m² in 2D).
+    pub melted_volume: f64,
+    pub pool_depth: f64,
+    pub pool_width: f64,
+    pub pool_length: f64,
+    /// Heat leaving through free surfaces by evaporation F22 (18) (W; W/m in 2D).
+    pub evaporated_power: f64,
+    /// Heat leaving through free surfaces by radiation (W; W/m in 2D).
+    pub radiated_power: f64,
+}
+
+/// (evaporated, radiated) power through free surfaces, host-side in f64 from the
+/// temperatures and surface deltas of the state.
+pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
+    if st.surface.is_empty() {
+        return (0.0, 0.0);
+    }
+    let (mut evap, mut rad) = (0.0, 0.0);
+    for i in 0..st.active() {
+        let ph = &m.phases[st.phase[i] as usize];
+        let Some(th) = ph.thermal.filter(|_| ph.conducts()) else {
+            continue;
+        };
+        let t = st.heat[i][1] as f64;
+        let area = st.surface[i][3] as f64 * st.mass[i] as f64 / ph.rho0;
+        if let Some(e) = th.evaporation {
+            evap += e.flux(t, th.heat_capacity) * area;
+        }
+        rad += th.radiated_flux(t, m.ambient_temperature) * area;
+    }
+    (evap, rad)
+}
+
+/// The heat figures of `st`; None outside heat scenes.
+pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
+    if st.heat.is_empty() {
+        return None;
+    }
+    let up = m.dim as usize - 1;
+    let cell = m.dx.powi(m.dim as i32);
+    let mut d = HeatDiagnostics {
+        max_temperature: f64::NEG_INFINITY,
+        total_enthalpy: 0.0,
+        absorbed_laser_power: m
+            .laser
+            .as_ref()
+            .map_or(0.0, |l| l.absorptivity * l.power_at(st.sim.time as f64)),
+        melted_volume: 0.0,
+        pool_depth: 0.0,
+        pool_width: 0.0,
+        pool_length: 0.0,
+        evaporated_power: 0.0,
+        radiated_power: 0.0,
+    };
+    (d.evaporated_power, d.radiated_power) = surface_loss_power(m, st);
+    let mut top = f64::NEG_INFINITY;
+    let mut pool = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+    for i in 0..st.active() {
+        let ph = &m.phases[st.phase[i] as usize];
+        if !ph.conducts() {
+            continue;
+        }
+        let [_, t, fl, _] = st.heat[i];
+        d.max_temperature = d.max_temperature.max(t as f64);
+        d.total_enthalpy += st.mass[i] as f64 * ph.absolute_enthalpy(st.heat[i][0]);
+        if ph.kind == PhaseKind::Gas {
+            continue;
+        }
+        let x = m.to_world(st.pos[i]);
+        top = top.max(x[up]);
+        d.melted_volume += fl as f64 * cell;
+        if fl >= 0.5 {
+            for a in 0..3 {
+                pool[a] = [pool[a][0].min(x[a]), pool[a][1].max(x[a])];
+            }
+        }
+    }
+    if pool[0][0].is_finite() {
+        let extent = |a: usize| pool[a][1] - pool[a][0] + m.dx;
+        d.pool_depth = top - pool[up][0] + 0.5 * m.dx;
+        d.pool_length = extent(0);
+        d.pool_width = if m.dim == 3 { extent(1) } else { 0.0 };
+    }
+    Some(d)
+}

@@ -1,0 +1,213 @@
+//! JSON schemas of the MCAP stream's JSON topics (Foxglove's plot panel reads the
+//! numbers; tools/spatter_read.py decodes with them).
+
+use crate::model::Model;
+use crate::state::DT_LIMIT_NAMES;
+
+/// JSON schema of a `/diagnostics` message (Foxglove's plot panel reads the numbers).
+pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    let per_depth = if m.dim == 2 {
+        " per metre of depth"
+    } else {
+        ""
+    };
+    let phases: serde_json::Map<String, serde_json::Value> = m
+        .phases
+        .iter()
+        .map(|p| (p.name.clone(), serde_json::json!({"type": "integer"})))
+        .collect();
+    let phase_masses: serde_json::Map<String, serde_json::Value> = m
+        .phases
+        .iter()
+        .map(|p| (p.name.clone(), serde_json::json!({"type": "number"})))
+        .collect();
+    let mut schema = serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Diagnostics",
+        "type": "object",
+        "properties": {
+            "time": num("simulated time, s"),
+            "step": {"type": "integer", "description": "step number"},
+            "dt": num("time step the next step takes, s"),
+            "dt_limit": {"type": "string", "enum": DT_LIMIT_NAMES,
+                         "description": "F22 (42) limit that binds dt"},
+            "kinetic_energy": num(&format!("fluid kinetic energy, J{per_depth}")),
+            "total_mass": num(&format!("fluid mass, kg{per_depth}")),
+            "max_speed": num("largest fluid speed, m/s"),
+            "min_density": num("smallest fluid density, kg/m^3"),
+            "max_density": num("largest fluid density, kg/m^3"),
+            "particles": {"type": "object", "properties": phases,
+                          "description": "particles in the domain per phase"},
+            "removed": {"type": "object", "properties": phases,
+                        "description": "particles that have left the domain per phase"},
+            "removed_mass": {"type": "object", "properties": phase_masses,
+                             "description": format!("mass of the particles that have left the domain per phase, kg{per_depth}")},
+            "wall_penetration_max_dx": num("deepest fluid penetration behind a wall face, dx"),
+            "wall_penetration_count": {"type": "integer",
+                                       "description": "fluid particles more than 0.5 dx behind a wall face"}
+        },
+        "required": ["time", "step", "dt", "dt_limit", "kinetic_energy", "total_mass",
+                     "max_speed", "min_density", "max_density", "particles",
+                     "removed", "removed_mass",
+                     "wall_penetration_max_dx", "wall_penetration_count"]
+    });
+    let any_recoil = m.phases.iter().any(|p| p.recoil().is_some());
+    if m.surface_tension.is_some() || (any_recoil && m.needs_interface()) {
+        let area = if m.dim == 2 {
+            "m per metre of depth"
+        } else {
+            "m^2"
+        };
+        schema["properties"]["surface_area"] = num(&format!(
+            "liquid surface, sum of V delta over liquid particles with a normal, {area}"
+        ));
+        schema["properties"]["mean_curvature"] = num(
+            "delta-weighted mean curvature of the liquid surface, 1/m (0 without surface tension)",
+        );
+        schema["properties"]["recoil_power"] = num(&format!(
+            "power of the recoil pressure on the liquid, W{per_depth}"
+        ));
+        schema["properties"]["capillary_number"] = num(
+            "largest liquid speed as eta |u| / alpha0 (spurious currents of a drop at rest; 0 without surface tension)",
+        );
+    }
+    if m.is_thermal() {
+        let unit = if m.dim == 2 {
+            " per metre of depth"
+        } else {
+            ""
+        };
+        let vol = if m.dim == 2 { "m^2" } else { "m^3" };
+        let extra = [
+            ("max_temperature", "largest temperature, K".to_string()),
+            (
+                "total_enthalpy",
+                format!("sum of m h over conducting particles, J{unit}"),
+            ),
+            (
+                "absorbed_laser_power",
+                format!("absorptivity x beam power, W{unit}"),
+            ),
+            (
+                "melted_volume",
+                format!("liquid-fraction-weighted volume of liquid and solid, {vol}"),
+            ),
+            (
+                "pool_depth",
+                "melt pool depth below the top of the condensed material, m".into(),
+            ),
+            ("pool_width", "melt pool extent along y (3D), m".into()),
+            ("pool_length", "melt pool extent along x, m".into()),
+            (
+                "evaporated_power",
+                format!("evaporation heat loss, W{unit}"),
+            ),
+            ("radiated_power", format!("radiation heat loss, W{unit}")),
+        ];
+        for (k, desc) in extra {
+            schema["properties"][k] = num(&desc);
+        }
+    }
+    if crate::track::wanted(m) {
+        schema["properties"]["depression_depth"] = num(
+            "depth of the surface under the beam below the initial surface, m (> 0: sunk; absent while the beam is outside the domain)",
+        );
+    }
+    schema
+}
+
+/// JSON schema of a `/bodies` message.
+pub fn bodies_schema() -> serde_json::Value {
+    let vec = |n: usize, desc: &str| serde_json::json!({"type": "array", "items": {"type": "number"}, "minItems": n, "maxItems": n, "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Bodies",
+        "description": "Every rigid body's motion at one frame (issue 17).",
+        "type": "object",
+        "properties": {
+            "time": {"type": "number", "description": "s"},
+            "bodies": {"type": "array", "items": {
+                "type": "object",
+                "properties": {
+                    "body": {"type": "integer", "description": "index + 1, as the frames' `body` channel"},
+                    "position": vec(3, "centre of mass, world coordinates (m)"),
+                    "orientation": vec(4, "unit quaternion (x, y, z, w) from the body's principal frame to world"),
+                    "velocity": vec(3, "of the centre of mass (m/s)"),
+                    "angular_velocity": vec(3, "world frame (rad/s)"),
+                    "mass": {"type": "number", "description": "kg (kg per metre of depth in 2D)"},
+                    "particles": {"type": "integer", "description": "member particles (melted ones have left)"},
+                    "molten_fraction": {"type": "number", "description": "fraction of the body's initial particles that melted away"},
+                    "bonded": {"type": "boolean", "description": "bonded into the substrate by melt that solidified against it (then fixed)"}
+                },
+                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles", "molten_fraction", "bonded"]
+            }}
+        },
+        "required": ["time", "bodies"]
+    })
+}
+
+/// JSON schema of a `/removed` message (crate::outflow::RemovalEvent).
+pub fn removal_schema() -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Removal",
+        "type": "object",
+        "properties": {
+            "id": {"type": "integer", "description": "particle id"},
+            "phase": {"type": "string", "description": "its phase"},
+            "time": num("when it left, s"),
+            "side": {"type": "string", "description": "the side it left through (x_min ... z_max)"},
+            "x": num("where it was at the end of that step, m"),
+            "y": num("m"),
+            "z": num("m"),
+            "speed": num("its speed then, m/s"),
+            "mass": num("kg (per metre of depth in 2D)")
+        },
+        "required": ["id", "phase", "time", "side", "x", "y", "z", "speed", "mass"]
+    })
+}
+
+/// JSON schema of the `/track` message (crate::track::TrackProfile).
+pub fn track_schema() -> serde_json::Value {
+    let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Track",
+        "type": "object",
+        "properties": {
+            "dx": num("slice width along x, m"),
+            "slices": {
+                "type": "array",
+                "description": "slices of width dx along x that the melt reached, in x order",
+                "items": {
+                    "type": "object",
+                    "properties": {
+                        "x": num("slice centre, m"),
+                        "initial_surface": num("top of the condensed material at the start, m (up axis)"),
+                        "depth": num("depth the melt reached below the initial surface, m"),
+                        "width": num("extent of the melt along y, m (0 in 2D)"),
+                        "height": num("resolidified surface minus initial surface, m (on the beam line in 3D)"),
+                        "peak_temperature": num("K")
+                    }
+                }
+            },
+            "pool": {
+                "type": "object",
+                "description": "the melt pool's extremes over the run's samples",
+                "properties": {
+                    "max_temperature": num("K"),
+                    "max_temperature_time": num("s"),
+                    "max_depth": num("m, below the top of the condensed material"),
+                    "max_depth_time": num("s"),
+                    "max_length": num("extent along x, m"),
+                    "max_width": num("extent along y, m (0 in 2D)"),
+                    "max_depression": num("deepest the surface under the beam sank below the initial surface, m"),
+                    "max_depression_time": num("s")
+                }
+            }
+        },
+        "required": ["dx", "slices", "pool"]
+    })
+}

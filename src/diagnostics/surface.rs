@@ -1,0 +1,65 @@
+//! Surface-force figures of a `/diagnostics` record (issue 16).
+
+use crate::model::Model;
+use crate::scene::PhaseKind;
+use crate::state::State;
+use serde::Serialize;
+
+/// Surface-force diagnostics (issue 16): the liquid's surface as the interface
+/// pass sees it (Σ V δ over liquid particles with a normal: m² in 3D, m per metre
+/// of depth in 2D), its δ-weighted mean curvature (1/m; scenes with surface
+/// tension, 0 otherwise), the power the recoil pressure does on the liquid,
+/// Σ V p_v δ (−n·u) (W; W/m in 2D; 0 without recoil), and the largest liquid
+/// speed as a capillary number η|u|/α0 (the spurious currents of a scene at
+/// rest; 0 without surface tension).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SurfaceDiagnostics {
+    pub surface_area: f64,
+    pub mean_curvature: f64,
+    pub recoil_power: f64,
+    pub capillary_number: f64,
+}
+
+/// The surface figures of `st`; None in scenes without surface tension or recoil.
+pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> {
+    let any_recoil = m.phases.iter().any(|p| p.recoil().is_some());
+    if st.surface.is_empty() || (m.surface_tension.is_none() && !any_recoil) {
+        return None;
+    }
+    let n = st.len();
+    let mut d = SurfaceDiagnostics {
+        surface_area: 0.0,
+        mean_curvature: 0.0,
+        recoil_power: 0.0,
+        capillary_number: 0.0,
+    };
+    let mut fastest: f64 = 0.0;
+    for i in 0..st.active() {
+        let ph = &m.phases[st.phase[i] as usize];
+        let s = st.surface[i];
+        if ph.kind == PhaseKind::Liquid {
+            let v = st.vel[i];
+            fastest = fastest.max((0..3).map(|a| (v[a] as f64).powi(2)).sum::<f64>().sqrt());
+        }
+        if ph.kind != PhaseKind::Liquid || s[3] == 0.0 {
+            continue;
+        }
+        let area = st.mass[i] as f64 / ph.rho0 * s[3] as f64;
+        d.surface_area += area;
+        d.mean_curvature += area * st.surface[n + i][1] as f64;
+        if let Some(e) = ph.recoil() {
+            let v = st.vel[i];
+            let un = (0..3).map(|a| s[a] as f64 * v[a] as f64).sum::<f64>();
+            d.recoil_power -= area * e.pressure(st.heat[i][1] as f64) * un;
+        }
+    }
+    if m.surface_tension.is_some() && d.surface_area > 0.0 {
+        d.mean_curvature /= d.surface_area;
+    } else {
+        d.mean_curvature = 0.0;
+    }
+    if let Some(t) = &m.surface_tension {
+        d.capillary_number = m.phases[t.liquid].viscosity * fastest / t.coefficient;
+    }
+    Some(d)
+}

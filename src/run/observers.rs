@@ -1,0 +1,176 @@
+//! Host-side observers of a run: each sees every state the run reads back, and
+//! concludes at the end. The run feeds them at one place per moment (`observe_all`)
+//! and never names one; a new observer is one entry in `list`.
+
+use super::{Outputs, RunEnd, RunOptions};
+use crate::checks::{CheckResult, Checker};
+use crate::diagnostics::{Diagnostics, Leakage, TRACK_TOPIC};
+use crate::model::Model;
+use crate::state::State;
+use crate::track::{Track, TrackProfile};
+
+/// Which state an observer is shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Moment {
+    /// The state the run starts from (the initial state, or the resumed one).
+    Initial,
+    /// A state read back at an output time; `frame`: a frame is written of it.
+    Sample { frame: bool },
+    /// The first bad state of an unstable run, as the replay found it.
+    Unstable,
+    /// The state a completed or interrupted run ends on.
+    Final,
+}
+
+/// What the observers conclude: their part of the `RunReport`.
+#[derive(Default)]
+pub struct Findings {
+    pub check: Option<CheckResult>,
+    pub leakage: Leakage,
+    pub track: Option<TrackProfile>,
+}
+
+/// A host-side observer of the states a run reads back.
+pub trait Observer {
+    /// Take in a state. The run shows it to every observer before writing any
+    /// output of it, so `annotate` describes the state being written.
+    fn observe(&mut self, m: &Model, st: &State, when: Moment);
+    /// Add this observer's figures to the `/diagnostics` record of the state it
+    /// observed last.
+    fn annotate(&self, _d: &mut Diagnostics) {}
+    /// Conclude from the state the run ends on (`last`, already observed), into
+    /// `found`; an observer with a topic of its own writes it to `out` (still open).
+    fn finish(
+        self: Box<Self>,
+        m: &Model,
+        last: &State,
+        end: &RunEnd,
+        out: &mut Outputs,
+        found: &mut Findings,
+    ) -> Result<(), String>;
+}
+
+/// The observers of a run of `m`, in the order they see each state.
+pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
+    let mut list: Vec<Box<dyn Observer>> = vec![Box::new(WallLeakage {
+        worst: Leakage::default(),
+        warned: false,
+        quiet: opts.quiet,
+    })];
+    if let Some(c) = Checker::new(m) {
+        list.push(Box::new(CheckObserver(c)));
+    }
+    if crate::track::wanted(m) {
+        list.push(Box::new(TrackObserver(None)));
+    }
+    list
+}
+
+/// Show `st` to every observer.
+pub fn observe_all(observers: &mut [Box<dyn Observer>], m: &Model, st: &State, when: Moment) {
+    for o in observers.iter_mut() {
+        o.observe(m, st, when);
+    }
+}
+
+/// The scene's check: it samples the initial state and every frame; its verdict
+/// needs a completed run (an interrupted or unstable one may hold no sample the
+/// reference covers).
+struct CheckObserver(Checker);
+
+impl Observer for CheckObserver {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        if matches!(when, Moment::Initial | Moment::Sample { frame: true }) {
+            self.0.observe(m, st);
+        }
+    }
+    fn finish(
+        mut self: Box<Self>,
+        m: &Model,
+        last: &State,
+        end: &RunEnd,
+        _out: &mut Outputs,
+        found: &mut Findings,
+    ) -> Result<(), String> {
+        // `Checker::finish` samples the final state itself.
+        if *end == RunEnd::Completed {
+            found.check = Some(self.0.finish(m, last));
+        }
+        Ok(())
+    }
+}
+
+/// Wall leakage (issue 18) over every state read back: the deepest penetration,
+/// warned about once (on the first sample that has one) unless the run is quiet.
+struct WallLeakage {
+    worst: Leakage,
+    warned: bool,
+    quiet: bool,
+}
+
+impl Observer for WallLeakage {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        let now = Leakage::of(m, st);
+        if when == Moment::Initial {
+            self.worst = now;
+            return;
+        }
+        self.worst.absorb(now);
+        let sample = matches!(when, Moment::Sample { .. });
+        if sample && !self.warned && self.worst.beyond_half_dx > 0 && !self.quiet {
+            self.warned = true;
+            eprintln!(
+                "warning: fluid leaks into the walls: {}; the run stops at {} dx (watchdog.wall_penetration)",
+                self.worst.summary(),
+                m.wall_stop_depth()
+            );
+        }
+    }
+    fn finish(
+        self: Box<Self>,
+        _m: &Model,
+        _last: &State,
+        _end: &RunEnd,
+        _out: &mut Outputs,
+        found: &mut Findings,
+    ) -> Result<(), String> {
+        found.leakage = self.worst;
+        Ok(())
+    }
+}
+
+/// The melt track of a laser scene with melting (issue 16): started on the
+/// initial state, it writes the depression under the beam into each
+/// `/diagnostics` record and its profile to `/track` at the end.
+struct TrackObserver(Option<Track>);
+
+impl Observer for TrackObserver {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        match (when, self.0.as_mut()) {
+            (Moment::Initial, _) => self.0 = Track::new(m, st),
+            (_, Some(t)) => t.observe(m, st),
+            (_, None) => {}
+        }
+    }
+    fn annotate(&self, d: &mut Diagnostics) {
+        d.depression_depth = self.0.as_ref().and_then(Track::depression_now);
+    }
+    fn finish(
+        self: Box<Self>,
+        m: &Model,
+        last: &State,
+        _end: &RunEnd,
+        out: &mut Outputs,
+        found: &mut Findings,
+    ) -> Result<(), String> {
+        let Some(track) = self.0 else {
+            return Ok(());
+        };
+        let profile = track.finish(m, last);
+        if let Some(sink) = out.mcap.as_mut() {
+            sink.message(TRACK_TOPIC, last.sim.time as f64, &profile)?;
+        }
+        found.track = Some(profile);
+        Ok(())
+    }
+}

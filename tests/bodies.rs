@@ -297,11 +297,10 @@ fn melting_grain_melts_conserving_mass_and_momentum() {
     // body pass sums since issue 27 (without it: 3.1e-5 of |P0|, above the
     // tolerance; with it 7.0e-7).
     run_passes(
-        "melting_grain_2d",
-        &[
-            "--set",
-            "simulation.barrier={radius_dx=0.9, stiffness=1.0e4, damping=0.0}",
-        ],
+        name,
+        &["simulation.barrier={radius_dx=0.9, stiffness=1.0e4, damping=0.0}"],
+        None,
+        MELTING_GRAIN_TOLERANCE,
     );
 }
 

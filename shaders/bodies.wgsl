@@ -1,5 +1,5 @@
 // uses: params consts kernel grid phase rigid
-// reads: rho press mass phase id heat sim
+// reads: rho press mass phase id heat sim continuity
 // writes: pos vel acc acc_b body body_offset bodies members slots
 // Rigid bodies (F22 2.2, 3.4) in the kick-drift-kick step: half kicks of V and
 // the world angular momentum L, drift, free rotation split into exact turns
@@ -114,13 +114,32 @@ fn body_forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             let vol_w = m_j / rho_w;
             let vv = vol_j * vol_j + vol_w * vol_w;
             let eta_j = P.phases[ph_j].eta;
-            let fp = pressure(press[j], p_r, rho_j, rho_w, dwdr, r);
-            let fv = viscosity(pair_viscosity(eta_j, eta_j, slip), dwdr, r);
+            var fp = 0.0;
+            if (!TERM_SHEPARD_PRESSURE) {
+                fp = pressure(press[j], p_r, rho_j, rho_w, dwdr, r);
+            }
+            let eta_jw = pair_viscosity(eta_j, eta_j, slip);
+            var fv = 0.0;
+            if (!TERM_MARRONE_VISCOSITY) {
+                fv = viscosity(eta_jw, dwdr, r);
+            }
             let v_j = vel[j];
             let dj = -d;
             for (var a = 0u; a < 3u; a++) {
                 let u = v_j[a] - v_r[a];
                 f[a] = f[a] - vv * (fp * dj[a] + fv * u);
+            }
+            if (TERM_SHEPARD_PRESSURE) {
+                let s = shepard_pressure(m_j, m_j, rho_j, rho_w, press[j], p_r, continuity[j].y, c_one(), dwdr, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] - s * dj[a];
+                }
+            }
+            if (TERM_MARRONE_VISCOSITY) {
+                let s = marrone_viscosity(m_j, m_j, rho_j, rho_w, eta_jw, v_j.xyz - v_r.xyz, dj, r2, dwdr, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] - s * dj[a];
+                }
             }
             if (TERM_SOLID_FLUID_VISCOSITY) {
                 // F22 (33) as the forces pass applies it between the melt and a

@@ -1,7 +1,8 @@
 // uses: params consts kernel grid phase
-// reads: pos vel rho press mass phase heat surface
+// reads: pos vel rho press mass phase heat surface continuity
 // writes: acc acc_b
-// Pressure + viscous forces F22 (23), transport-velocity background pressure
+// Pressure + viscous forces F22 (23) (or R18 (3.17), (3.18) under delta_wcsph),
+// transport-velocity background pressure
 // (Adami 2013), interface viscosity F22 (31), solid-fluid viscosity F22 (33),
 // viscous heating, the wall barrier
 // F22 (34) and gravity: one
@@ -38,6 +39,10 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     if (TERM_INTERFACE_VISCOSITY && P.flow.interface_viscosity > 0.0) {
         alpha_i = interface_viscosity_alpha(surface[i].w);
     }
+    var gamma_i = c_one();
+    if (TERM_SHEPARD_PRESSURE) {
+        gamma_i = continuity[i].y;
+    }
     var alpha_sf_i = 0.0;
     if (TERM_SOLID_FLUID_VISCOSITY) {
         alpha_sf_i = solid_fluid_viscosity_alpha(phase[i], heat[i].y);
@@ -63,12 +68,36 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
             let vol_j = m_j / rho_j;
             let vv = vol_i * vol_i + vol_j * vol_j;
             // The pair terms, in the order of backend::terms::PAIR_TERMS.
-            let fp = pressure(p_i, p_j, rho_i, rho_j, dwdr, r);
-            let fv = viscosity(pair_viscosity(eta_i, eta_j, slip), dwdr, r);
+            // F22 (23)'s pressure and viscosity, or (delta_wcsph) R18's.
+            var fp = 0.0;
+            if (!TERM_SHEPARD_PRESSURE) {
+                fp = pressure(p_i, p_j, rho_i, rho_j, dwdr, r);
+            }
+            let eta_ij = pair_viscosity(eta_i, eta_j, slip);
+            var fv = 0.0;
+            if (!TERM_MARRONE_VISCOSITY) {
+                fv = viscosity(eta_ij, dwdr, r);
+            }
             let v_j = vel[j];
             for (var a = 0u; a < 3u; a++) {
                 let u = v_i[a] - v_j[a];
                 f[a] = f[a] + vv * (fp * d[a] + fv * u);
+            }
+            if (TERM_SHEPARD_PRESSURE) {
+                var gamma_j = c_one();
+                if (!wall) {
+                    gamma_j = continuity[j].y;
+                }
+                let s = shepard_pressure(m_i, m_j, rho_i, rho_j, p_i, p_j, gamma_i, gamma_j, dwdr, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] + s * d[a];
+                }
+            }
+            if (TERM_MARRONE_VISCOSITY) {
+                let s = marrone_viscosity(m_i, m_j, rho_i, rho_j, eta_ij, v_i.xyz - v_j.xyz, d, r2, dwdr, r);
+                for (var a = 0u; a < 3u; a++) {
+                    f[a] = f[a] + s * d[a];
+                }
             }
             if (TERM_BACKGROUND_PRESSURE) {
                 let fbg = background_pressure(pb, dwdr, r);

@@ -58,6 +58,9 @@ pub struct Header {
     /// Trapezoidal (Crank–Nicolson) heat: the heat_start array follows.
     #[serde(default)]
     pub heat_start: bool,
+    /// δ-SPH: the continuity array follows (and the density is state).
+    #[serde(default)]
+    pub continuity: bool,
     /// Entries of each table (crate::fields::TABLES), stored after the particle
     /// arrays in registry order; a table not named here is empty.
     #[serde(default)]
@@ -89,6 +92,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         surface: !st.surface.is_empty(),
         bodies: !st.body.is_empty(),
         heat_start: !st.heat_start.is_empty(),
+        continuity: !st.continuity.is_empty(),
         tables: TABLES
             .iter()
             .map(|t| (t.name.to_string(), t.entries(st) as u64))
@@ -169,6 +173,7 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         bodies: header.bodies,
         implicit_heat: header.heat_start,
         solvers: false, // a table, not a particle array
+        continuity: header.continuity,
     };
     let mut state = State::default();
     for f in FIELDS.iter().filter(|f| f.checkpointed) {

@@ -29,6 +29,8 @@ pub enum Holder {
     ImplicitHeat,
     /// Scenes whose schedule holds a repeat (solver slots).
     Solvers,
+    /// The δ-SPH formulation (continuity density: ρ is state, sorted).
+    Continuity,
 }
 
 /// The scene's holders, from the pipeline's features.
@@ -39,6 +41,7 @@ pub struct Held {
     pub bodies: bool,
     pub implicit_heat: bool,
     pub solvers: bool,
+    pub continuity: bool,
 }
 
 impl Held {
@@ -50,6 +53,7 @@ impl Held {
             Holder::Bodies => self.bodies,
             Holder::ImplicitHeat => self.implicit_heat,
             Holder::Solvers => self.solvers,
+            Holder::Continuity => self.continuity,
         }
     }
     /// What a state holds (its optional arrays are empty when not held).
@@ -60,6 +64,7 @@ impl Held {
             bodies: !st.body.is_empty(),
             implicit_heat: !st.heat_start.is_empty(),
             solvers: !st.solvers.is_empty(),
+            continuity: !st.continuity.is_empty(),
         }
     }
     /// What a scene holds, from its model (the same as its schedule's features:
@@ -72,8 +77,9 @@ impl Held {
             interface: m.needs_interface(),
             bodies: m.has_bodies(),
             implicit_heat,
-            // The implicit heat is the only repeat so far.
+            // The trapezoidal heat is the only repeat so far.
             solvers: implicit_heat,
+            continuity: m.formulation == crate::scene::Formulation::DeltaWcsph,
         }
     }
 }
@@ -84,8 +90,11 @@ pub struct FieldDef {
     /// Its WGSL storage binding.
     pub binding: &'static str,
     /// The binding of its reorder scratch: the neighbour pass sorts it with the
-    /// particles. None: recomputed after every sort (density, pressure, normals).
+    /// particles. None: recomputed after every sort (pressure, normals).
     pub scratch: Option<&'static str>,
+    /// The scenes that sort it (`Every` where it is held, or e.g. `Continuity`:
+    /// the density is state under δ-SPH and recomputed by summation otherwise).
+    pub sorted_when: Holder,
     /// 32-bit words per entry (4 for a vec4).
     pub components: usize,
     /// Entries per particle (2 for `surface`: normal and δ, then the Shepard sum).
@@ -110,6 +119,10 @@ pub struct FieldDef {
 pub type Channels = fn(&crate::model::Model, &State) -> Vec<crate::output::Field>;
 
 impl FieldDef {
+    /// Whether the neighbour pass carries it through the sort in a scene.
+    pub fn sorted_in(&self, held: Held) -> bool {
+        self.scratch.is_some() && held.holds(self.holder) && held.holds(self.sorted_when)
+    }
     pub fn bytes_per_particle(&self) -> usize {
         4 * self.components * self.per_particle
     }
@@ -119,10 +132,16 @@ impl FieldDef {
 macro_rules! field {
     ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
      $per:literal, $float:literal, $holder:expr, $frames:expr) => {
+        field!($name, $array, $binding, $scratch, $components, $per, $float, $holder,
+            $frames, Holder::Every)
+    };
+    ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
+     $per:literal, $float:literal, $holder:expr, $frames:expr, $sorted:expr) => {
         FieldDef {
             name: $name,
             binding: $binding,
             scratch: $scratch,
+            sorted_when: $sorted,
             components: $components,
             per_particle: $per,
             is_float: $float,
@@ -141,7 +160,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 14] = [
+pub const FIELDS: [FieldDef; 15] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -149,8 +168,11 @@ pub const FIELDS: [FieldDef; 14] = [
     field!("acceleration", acc, "acc", Some("s_acc"), 4, 1, true, Holder::Every, None),
     field!("transport_acceleration", acc_b, "acc_b", Some("s_acc_b"), 4, 1, true,
         Holder::Every, None),
-    field!("density", rho, "rho", None, 1, 1, true, Holder::Every,
-        Some(|_, s| output::channel("density", Values::F32(s.rho.clone())))),
+    // Summation density (recomputed after the sort), or under δ-SPH the
+    // continuity equation's state (sorted).
+    field!("density", rho, "rho", Some("s_rho"), 1, 1, true, Holder::Every,
+        Some(|_, s| output::channel("density", Values::F32(s.rho.clone()))),
+        Holder::Continuity),
     field!("pressure", press, "press", None, 1, 1, true, Holder::Every,
         Some(|_, s| output::channel("pressure", Values::F32(s.press.clone())))),
     field!("mass", mass, "mass", Some("s_mass"), 1, 1, true, Holder::Every,
@@ -166,6 +188,10 @@ pub const FIELDS: [FieldDef; 14] = [
     field!("body", body, "body", None, 1, 1, false, Holder::Bodies,
         Some(output::body_channels)),
     field!("body_offset", body_offset, "body_offset", None, 4, 1, true, Holder::Bodies,
+        None),
+    // δ-SPH: (dρ/dt, Shepard sum Γ), written by the continuity pass every step
+    // after the sort.
+    field!("continuity", continuity, "continuity", None, 2, 1, true, Holder::Continuity,
         None),
     // Written by heat.begin every step after the sort (no scratch needed).
     field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
@@ -236,22 +262,24 @@ fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[usize]) {
 /// sorted field's scratch at k takes the field at s; a field only some scenes hold
 /// is guarded by that scene flag.
 pub fn wgsl_reorder(k: &str, s: &str, indent: &str) -> String {
+    let flag = |h: Holder| match h {
+        Holder::Heat => Some("FLAG_HEAT"),
+        Holder::Bodies => Some("FLAG_BODIES"),
+        Holder::Interface => Some("FLAG_INTERFACE"),
+        Holder::Continuity => Some("FLAG_CONTINUITY"),
+        Holder::Every => None,
+        other => panic!("no scene flag for sorted fields of {other:?}"),
+    };
     let mut out = String::new();
     for f in FIELDS.iter() {
         let Some(scratch) = f.scratch else { continue };
         let copy = format!("{scratch}[{k}] = {}[{s}];", f.binding);
-        match f.holder {
-            Holder::Every => out.push_str(&format!("{indent}{copy}\n")),
-            h => {
-                let flag = match h {
-                    Holder::Heat => "FLAG_HEAT",
-                    Holder::Bodies => "FLAG_BODIES",
-                    _ => "FLAG_INTERFACE",
-                };
-                out.push_str(&format!(
-                    "{indent}if ((P.sizes.flags & {flag}) != 0u) {{\n{indent}    {copy}\n{indent}}}\n"
-                ));
-            }
+        let guards: Vec<&str> = [f.holder, f.sorted_when].into_iter().filter_map(flag).collect();
+        match guards.first() {
+            None => out.push_str(&format!("{indent}{copy}\n")),
+            Some(g) => out.push_str(&format!(
+                "{indent}if ((P.sizes.flags & {g}) != 0u) {{\n{indent}    {copy}\n{indent}}}\n"
+            )),
         }
     }
     out
@@ -262,7 +290,7 @@ pub fn bytes_per_particle(held: Held) -> usize {
     FIELDS
         .iter()
         .filter(|f| held.holds(f.holder))
-        .map(|f| f.bytes_per_particle() * if f.scratch.is_some() { 2 } else { 1 })
+        .map(|f| f.bytes_per_particle() * if f.sorted_in(held) { 2 } else { 1 })
         .sum()
 }
 

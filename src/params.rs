@@ -41,6 +41,10 @@ pub const FLAG_WETTING: u32 = 2048;
 /// The scene has rigid bodies (`bodies`): the body passes run and the body
 /// fields exist.
 pub const FLAG_BODIES: u32 = 4096;
+/// δ-SPH (R18): the density is continuity state (`continuity` pass, sorted).
+pub const FLAG_CONTINUITY: u32 = 8192;
+/// δ-SPH with R18 (3.18)'s viscous term (`simulation.viscosity_form = "marrone"`).
+pub const FLAG_MARRONE_VISCOSITY: u32 = 16384;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -335,6 +339,13 @@ gpu_struct! {
         pub heat_tolerance: f32,
         /// Trapezoidal rule: the repeat's bound.
         pub heat_max_iterations: u32,
+        /// δ-SPH: δ h c0 of the density diffusion R18 (3.53) (c0 the largest
+        /// sound speed).
+        pub delta_hc: f32,
+        /// δ-SPH: 2 (d + 2) of the Monaghan–Marrone viscosity R18 (3.18).
+        pub viscosity_factor: f32,
+        pub pad0: f32,
+        pub pad1: f32,
     }
 }
 
@@ -527,7 +538,17 @@ impl Params {
             },
             heat_tolerance: m.heat.tolerance as f32,
             heat_max_iterations: m.heat.max_iterations,
+            delta_hc: m.delta.map_or(0.0, |d| (d * m.h * m.max_sound_speed()) as f32),
+            viscosity_factor: (2.0 * (m.dim as f64 + 2.0)) as f32,
+            pad0: 0.0,
+            pad1: 0.0,
         };
+        if m.delta.is_some() {
+            p.sizes.flags |= FLAG_CONTINUITY;
+        }
+        if m.viscosity_form == crate::scene::ViscosityForm::Marrone {
+            p.sizes.flags |= FLAG_MARRONE_VISCOSITY;
+        }
         p.consts = SHADER_CONSTS;
         if m.needs_interface() {
             let gas = m.phases.iter().find(|ph| ph.kind == PhaseKind::Gas);

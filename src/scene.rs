@@ -52,6 +52,8 @@ impl KernelKind {
 #[serde(rename_all = "snake_case")]
 pub enum Formulation {
     Wcsph,
+    /// R18's δ-SPH: continuity density with density diffusion on ρ − ρ0.
+    DeltaWcsph,
 }
 
 impl Formulation {
@@ -59,19 +61,33 @@ impl Formulation {
     pub fn code(self) -> u32 {
         match self {
             Formulation::Wcsph => 0,
+            Formulation::DeltaWcsph => 1,
         }
     }
     pub fn from_code(code: u32) -> Formulation {
         match code {
             0 => Formulation::Wcsph,
+            1 => Formulation::DeltaWcsph,
             c => panic!("no formulation with code {c}"),
         }
     }
     pub fn name(self) -> &'static str {
         match self {
             Formulation::Wcsph => "wcsph",
+            Formulation::DeltaWcsph => "delta_wcsph",
         }
     }
+}
+
+/// `simulation.viscosity_form`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ViscosityForm {
+    /// Morris et al. 1997 (F22 (23)): Σ (V_i² + V_j²) η̃ u_ij (∂W/∂r)/r.
+    #[default]
+    Morris,
+    /// Monaghan–Gingold in Marrone's multiphase form (R18 (3.18)).
+    Marrone,
 }
 
 /// `[heat] integrator`: how the enthalpy advances over a step.
@@ -297,6 +313,13 @@ pub struct Simulation {
     pub dimension: u32,
     #[serde(default = "default_formulation")]
     pub formulation: Formulation,
+    /// δ-SPH (formulation = "delta_wcsph"): the density diffusion coefficient δ
+    /// of R18 (3.53) (R18 prints none; Antuono et al. 2012's 0.1 is the default).
+    pub delta: Option<f64>,
+    /// δ-SPH: the viscous term, F22 (23)'s (`morris`, default) or R18 (3.18)'s
+    /// (`marrone`; 17% weak in shear at h = Δx with the quintic: docs/physics.md).
+    #[serde(default)]
+    pub viscosity_form: ViscosityForm,
     #[serde(default = "default_kernel")]
     pub kernel: KernelKind,
     pub h_over_dx: Option<f64>,

@@ -349,6 +349,9 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     if held.implicit_heat {
         st.heat_start = vec![[0.0; 4]; st.len()];
     }
+    if held.continuity {
+        st.continuity = vec![[0.0, 1.0]; st.len()];
+    }
     if held.solvers {
         st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];
     }

@@ -68,8 +68,12 @@ pub struct State {
     /// Particle ids of every body's members, body after body in ascending id
     /// (`Body::first`, `Body::count`): the fixed order of the per-body sums.
     pub members: Vec<u32>,
-    /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser source of
-    /// the step, and the last iteration's |ḣ_k − ḣ_{k−1}| and |ḣ_k|.
+    /// δ-SPH only (empty otherwise): dρ/dt of the continuity equation and the
+    /// Shepard sum Γ of the particle's support.
+    pub continuity: Vec<[f32; 2]>,
+    /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser
+    /// source of the step, the first iteration's rate ḣ_0 and the last
+    /// iteration's |ḣ_k − ḣ_{k−1}|.
     pub heat_start: Vec<[f32; 4]>,
     /// Scenes whose schedule holds a repeat (empty otherwise): one entry per
     /// solver slot (backend::schedule::SOLVER_SLOTS), this step's iterations,

@@ -253,6 +253,39 @@ fn implicit_heat_repeat() {
     }
 }
 
+const DELTA: &str = "simulation.formulation=\"delta_wcsph\"";
+
+/// Issue 28: R18's δ-SPH (continuity density, the same-phase density diffusion,
+/// the Shepard pressure R18 (3.17); sorted density), 2D and 3D: a dam break
+/// against walls, liquid under gas at density ratio 1000, the free-surface
+/// tension disc, and R18 (3.18)'s viscosity option in a channel.
+#[test]
+fn delta_sph_200_steps() {
+    assert_bit_identical("dam_break_2d", &[DELTA], 200);
+    assert_bit_identical("two_layer_ratio1000_2d", &[DELTA], 200);
+    assert_bit_identical("laplace_free_disc_2d", &[DELTA], 200);
+    assert_bit_identical(
+        "poiseuille_2d",
+        &[DELTA, "simulation.viscosity_form=\"marrone\""],
+        200,
+    );
+    assert_bit_identical("dam_break_3d", &[DELTA, "dx=0.02"], 100);
+}
+
+/// δ-SPH with heat, melting and the line melt's forces (the main job's scene),
+/// and with rigid bodies in a walled liquid (the body pass's reaction through
+/// the Shepard pressure).
+#[test]
+fn delta_sph_with_heat_and_bodies_200_steps() {
+    assert_bit_identical("melt_block_3d", &[DELTA], 100);
+    assert_bit_identical("settling_disc_2d", &[DELTA], 200);
+    assert_bit_identical_at(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/pbf/line_melt_coarse_2d.toml"),
+        &[DELTA],
+        200,
+    );
+}
+
 /// The hardware comparison (by tolerance, each pass started from the CPU state) run
 /// on the software adapter: loading the CPU state into the device before a pass must
 /// leave nothing behind, so every pass and the free-running step differ by exactly 0.

@@ -207,6 +207,8 @@ fn flag_and_code_constants_match() {
         ("FLAG_FREE_SURFACE_TENSION", rs::FLAG_FREE_SURFACE_TENSION),
         ("FLAG_WETTING", rs::FLAG_WETTING),
         ("FLAG_BODIES", rs::FLAG_BODIES),
+        ("FLAG_CONTINUITY", rs::FLAG_CONTINUITY),
+        ("FLAG_MARRONE_VISCOSITY", rs::FLAG_MARRONE_VISCOSITY),
         ("NO_BODY", spatter::state::NO_BODY),
         ("NO_PHASE", rs::NO_PHASE),
         ("KIND_LIQUID", rs::KIND_LIQUID),

@@ -120,6 +120,10 @@ struct Solve {                // the formulation and its solvers (backend::sched
     heat_integrator: u32,     // HEAT_EULER, HEAT_TRAPEZOIDAL
     heat_tolerance: f32,
     heat_max_iterations: u32,
+    delta_hc: f32,            // delta h c0, R18 (3.53)
+    viscosity_factor: f32,    // 2 (d + 2), R18 (3.18)
+    pad0: f32,
+    pad1: f32,
 }
 
 struct Phase {
@@ -251,6 +255,8 @@ const FLAG_RECOIL: u32 = 512u;
 const FLAG_FREE_SURFACE_TENSION: u32 = 1024u;
 const FLAG_WETTING: u32 = 2048u;
 const FLAG_BODIES: u32 = 4096u;
+const FLAG_CONTINUITY: u32 = 8192u;
+const FLAG_MARRONE_VISCOSITY: u32 = 16384u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;

@@ -5,7 +5,7 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
+    Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
     FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT,
     LASER_SURFACE,
 };
@@ -19,6 +19,9 @@ pub enum Stage {
     Neighbors,
     /// Summation density and equation of state.
     Density,
+    /// δ-SPH: the continuity equation's rate (R18 (3.14), (3.53)) and Shepard
+    /// sum, then the density update and equation of state.
+    Continuity,
     /// Adami (2012) wall pressure and velocity.
     Wall,
     /// Shepard sum, then interface normal and surface delta.
@@ -89,6 +92,8 @@ pub struct Features {
     pub bodies: bool,
     /// Heat integrated by the trapezoidal rule (R18 Algorithm 3.1).
     pub implicit_heat: bool,
+    /// δ-SPH: the density is continuity state (R18 §3.1.2).
+    pub continuity: bool,
 }
 
 impl Features {
@@ -112,6 +117,7 @@ impl Features {
             bodies: params.flag(FLAG_BODIES),
             implicit_heat: params.flag(FLAG_HEAT)
                 && params.solve.heat_integrator == HEAT_TRAPEZOIDAL,
+            continuity: params.flag(FLAG_CONTINUITY),
         }
     }
 }
@@ -202,7 +208,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 19] = [
+pub const STAGES: [StageDef; 20] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -225,6 +231,16 @@ pub const STAGES: [StageDef; 19] = [
         file: "density",
         needed: |f| f.fluid,
         dispatches: &[always("density", Work::Particles, |b| b.density())],
+    },
+    StageDef {
+        stage: Stage::Continuity,
+        name: "continuity",
+        file: "continuity",
+        needed: |f| f.fluid && f.continuity,
+        dispatches: &[
+            always("continuity_rate", Work::Particles, |b| b.continuity_rate()),
+            always("continuity_update", Work::Particles, |b| b.continuity_update()),
+        ],
     },
     StageDef {
         stage: Stage::Wall,

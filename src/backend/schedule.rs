@@ -70,10 +70,16 @@ pub struct FormulationDef {
     pub schedule: fn(&Features, &Params) -> (Vec<Node>, Vec<Node>),
 }
 
-pub const FORMULATIONS: [FormulationDef; 1] = [FormulationDef {
-    formulation: Formulation::Wcsph,
-    schedule: wcsph,
-}];
+pub const FORMULATIONS: [FormulationDef; 2] = [
+    FormulationDef {
+        formulation: Formulation::Wcsph,
+        schedule: wcsph,
+    },
+    FormulationDef {
+        formulation: Formulation::DeltaWcsph,
+        schedule: delta_wcsph,
+    },
+];
 
 /// One velocity-Verlet (kick–drift–kick) step, F22 §3.4 with heat (J22, F22 §3.2)
 /// inside it: heat is explicit Euler, conduction reading the temperatures of the
@@ -121,6 +127,23 @@ fn wcsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
         })
         .collect();
     (step, stage_nodes(&WCSPH_PRIME, f))
+}
+
+/// R18's δ-SPH (§3.1.2): F22's step with the continuity density in place of the
+/// summation density; the forces pass takes R18 (3.17) and (3.18) (terms.rs).
+fn delta_wcsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
+    let swap = |nodes: Vec<Node>| -> Vec<Node> {
+        nodes
+            .into_iter()
+            .map(|n| match n {
+                Node::Stage(Stage::Density) => Node::Stage(Stage::Continuity),
+                n => n,
+            })
+            .collect()
+    };
+    // The density stage is `needed` by fluid alone: build with it, then swap.
+    let (step, prime) = wcsph(f, p);
+    (swap(step), swap(prime))
 }
 
 /// R18 Algorithm 3.1: the enthalpy update by the trapezoidal rule, solved
@@ -203,6 +226,7 @@ impl Pipeline {
             bodies: f.bodies,
             implicit_heat: f.implicit_heat,
             solvers: self.has_solvers(),
+            continuity: f.continuity,
         }
     }
     /// Leave `stage` out of every later step (bench throughput).

@@ -8,7 +8,7 @@
 //! is set false when the pipeline is created, on the CPU the sweep is
 //! monomorphised without it; neither tests a flag per pair.
 
-use crate::params::{Params, FLAG_VISCOUS_HEATING};
+use crate::params::{Params, FLAG_CONTINUITY, FLAG_MARRONE_VISCOSITY, FLAG_VISCOUS_HEATING};
 
 /// The neighbours a term acts between a fluid particle and: other fluid
 /// particles, wall (and fixed solid) particles, rigid-body particles.
@@ -62,7 +62,7 @@ pub struct PairTerm {
     pub needs: &'static [&'static str],
 }
 
-pub const PAIR_TERMS: [PairTerm; 7] = [
+pub const PAIR_TERMS: [PairTerm; 9] = [
     PairTerm {
         name: "pressure",
         pass: "forces",
@@ -79,6 +79,26 @@ pub const PAIR_TERMS: [PairTerm; 7] = [
         wgsl: include_str!("../../shaders/terms/viscosity.wgsl"),
         switch: None,
         active: |_| true,
+        acts: ALL,
+        sum: Sum::Force,
+        needs: &[],
+    },
+    PairTerm {
+        name: "shepard_pressure",
+        pass: "forces",
+        wgsl: include_str!("../../shaders/terms/shepard_pressure.wgsl"),
+        switch: Some("TERM_SHEPARD_PRESSURE"),
+        active: |p| p.flag(FLAG_CONTINUITY),
+        acts: ALL,
+        sum: Sum::Force,
+        needs: &[],
+    },
+    PairTerm {
+        name: "marrone_viscosity",
+        pass: "forces",
+        wgsl: include_str!("../../shaders/terms/marrone_viscosity.wgsl"),
+        switch: Some("TERM_MARRONE_VISCOSITY"),
+        active: |p| p.flag(FLAG_MARRONE_VISCOSITY),
         acts: ALL,
         sum: Sum::Force,
         needs: &[],

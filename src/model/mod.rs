@@ -139,6 +139,11 @@ pub struct Model {
     pub contact: Option<Contact>,
     /// `[heat]`: the energy equation's time integration (heat scenes).
     pub heat: HeatIntegration,
+    /// δ-SPH: the density diffusion coefficient δ (Some exactly when the
+    /// formulation is `delta_wcsph`).
+    pub delta: Option<f64>,
+    /// The viscous term (δ-SPH may take R18 (3.18)'s).
+    pub viscosity_form: crate::scene::ViscosityForm,
     pub limits: DtLimits,
 }
 
@@ -521,6 +526,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
     let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
+    let delta = delta_coefficient(&cx, sim)?;
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
@@ -588,8 +594,42 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         bodies,
         contact,
         heat,
+        delta,
+        viscosity_form: sim.viscosity_form,
         limits,
     })
+}
+
+/// `simulation.delta` (δ-SPH only): 0 ≤ δ ≤ 1.
+fn delta_coefficient(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Option<f64>, InputError> {
+    use crate::scene::Formulation;
+    match (sim.formulation, sim.delta) {
+        (Formulation::DeltaWcsph, d) => {
+            let d = d.unwrap_or(0.1);
+            if !(0.0..=1.0).contains(&d) {
+                return Err(cx.err(
+                    "simulation.delta",
+                    format!("must be between 0 and 1 (got {d}; Antuono et al. use 0.1)"),
+                ));
+            }
+            if sim.viscous_heating {
+                return Err(cx.err(
+                    "simulation.viscous_heating",
+                    "is F22's dissipation of its own viscous term; formulation = \"delta_wcsph\" uses R18 (3.18)'s: not built for it yet",
+                ));
+            }
+            Ok(Some(d))
+        }
+        _ if sim.viscosity_form != crate::scene::ViscosityForm::Morris => Err(cx.err(
+            "simulation.viscosity_form",
+            "\"marrone\" is R18 (3.18), built for formulation = \"delta_wcsph\" only",
+        )),
+        (_, Some(_)) => Err(cx.err(
+            "simulation.delta",
+            "is the δ-SPH density diffusion: set formulation = \"delta_wcsph\" or leave it out",
+        )),
+        (_, None) => Ok(None),
+    }
 }
 
 /// `[powder]`: the grains' phase (solid or wall), a box inside the domain, then

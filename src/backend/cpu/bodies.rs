@@ -183,7 +183,9 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
     let reach2 = bp.contact_distance * bp.contact_distance;
     let sf = crate::backend::terms::active(pr, "solid_fluid_viscosity");
     let br = crate::backend::terms::active(pr, "barrier");
-    let heat = &st.heat;
+    let df = crate::backend::terms::active(pr, "shepard_pressure");
+    let marrone = crate::backend::terms::active(pr, "marrone_viscosity");
+    let (heat, cont) = (&st.heat, &st.continuity);
     st.acc[..n].par_iter_mut().enumerate().for_each(|(i, a)| {
         let k = body[id[i] as usize];
         if k == NO_BODY {
@@ -205,13 +207,39 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                 let rho_w = mat.rho0 + p_r / mat.c2;
                 let vol_w = m_j / rho_w;
                 let vv = vol_j * vol_j + vol_w * vol_w;
-                let fp = terms::pressure(press[j], p_r, rho_j, rho_w, dwdr, r);
-                let fv = terms::viscosity(terms::pair_viscosity(mat.eta, mat.eta, slip), dwdr, r);
+                let fp = if df {
+                    0.0
+                } else {
+                    terms::pressure(press[j], p_r, rho_j, rho_w, dwdr, r)
+                };
+                let eta_jw = terms::pair_viscosity(mat.eta, mat.eta, slip);
+                let fv = if marrone {
+                    0.0
+                } else {
+                    terms::viscosity(eta_jw, dwdr, r)
+                };
                 let v_j = vel[j];
                 let dj = [-d[0], -d[1], -d[2]];
                 for c in 0..3 {
                     let u = v_j[c] - v_r[c];
                     f[c] -= vv * (fp * dj[c] + fv * u);
+                }
+                if df {
+                    let s = terms::shepard_pressure(
+                        m_j, m_j, rho_j, rho_w, press[j], p_r, cont[j][1], 1.0, dwdr, r,
+                    );
+                    for c in 0..3 {
+                        f[c] -= s * dj[c];
+                    }
+                }
+                if marrone {
+                    let u = [v_j[0] - v_r[0], v_j[1] - v_r[1], v_j[2] - v_r[2]];
+                    let s = terms::marrone_viscosity(
+                        pr, m_j, m_j, rho_j, rho_w, eta_jw, u, dj, r2, dwdr, r,
+                    );
+                    for c in 0..3 {
+                        f[c] -= s * dj[c];
+                    }
                 }
                 if sf {
                     // F22 (33) as the forces pass applies it between the melt

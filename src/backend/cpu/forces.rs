@@ -44,14 +44,25 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
         active(pr, "interface_viscosity"),
         active(pr, "solid_fluid_viscosity"),
         active(pr, "viscous_heating"),
-        active(pr, "barrier")
+        active(pr, "barrier"),
+        // delta_wcsph: R18's pressure (and the option of its viscosity).
+        active(pr, "shepard_pressure")
     ])
 }
 
 /// One fused neighbour sweep: BG, IV, SF, VH, BR switch the background pressure,
 /// the interface viscosity, the solid–fluid viscosity, the viscous heating and
-/// the wall barrier.
-fn sweep<const BG: bool, const IV: bool, const SF: bool, const VH: bool, const BR: bool>(
+/// the wall barrier; DF takes R18 (3.17) in place of F22 (23)'s pressure (and,
+/// when the scene asks, R18 (3.18) in place of its viscosity).
+#[allow(clippy::too_many_arguments)]
+fn sweep<
+    const BG: bool,
+    const IV: bool,
+    const SF: bool,
+    const VH: bool,
+    const BR: bool,
+    const DF: bool,
+>(
     pr: &Params,
     st: &mut State,
     grid: &CellTable,
@@ -60,10 +71,13 @@ fn sweep<const BG: bool, const IV: bool, const SF: bool, const VH: bool, const B
     let n = st.active();
     let (pos, vel, rho, p, mass, phase) =
         (&st.pos, &st.vel, &st.rho, &st.press, &st.mass, &st.phase);
-    let (surface, heat) = (&st.surface, &st.heat);
+    let (surface, heat, cont) = (&st.surface, &st.heat, &st.continuity);
     // Per particle and per phase pair once, what the pair loop would otherwise
     // compute per pair from the same operands: the same bits, fewer divisions.
     let eta_pair = PairViscosity::new(pr);
+    // R18 (3.18) in place of F22's viscous term: a δ-SPH option (DF), tested per
+    // pair only in the δ sweeps.
+    let marrone = active(pr, "marrone_viscosity");
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
     st.acc[..n]
         .par_iter_mut()
@@ -87,6 +101,7 @@ fn sweep<const BG: bool, const IV: bool, const SF: bool, const VH: bool, const B
             } else {
                 0.0
             };
+            let gamma_i = if DF { cont[i][1] } else { 1.0 };
             let alpha_sf_i = if SF {
                 terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][1])
             } else {
@@ -109,13 +124,42 @@ fn sweep<const BG: bool, const IV: bool, const SF: bool, const VH: bool, const B
                     (rho[j], mass[j], vol[j])
                 };
                 let vv = vol_i * vol_i + vol_j * vol_j;
-                // The pair terms, in the order of backend::terms::PAIR_TERMS.
-                let fp = terms::pressure(p_i, p_j, rho_i, rho_j, dwdr, r);
-                let fv = terms::viscosity(eta_pair.get(ph_i, ph_j), dwdr, r);
+                // The pair terms, in the order of backend::terms::PAIR_TERMS:
+                // F22 (23)'s pressure and viscosity, or (DF) R18's pressure
+                // and (DF and the scene's option) R18's viscosity.
+                let fp = if DF {
+                    0.0
+                } else {
+                    terms::pressure(p_i, p_j, rho_i, rho_j, dwdr, r)
+                };
+                let eta_ij = eta_pair.get(ph_i, ph_j);
+                let fv = if DF && marrone {
+                    0.0
+                } else {
+                    terms::viscosity(eta_ij, dwdr, r)
+                };
                 let v_j = vel[j];
                 for a in 0..3 {
                     let u = v_i[a] - v_j[a];
                     f[a] += vv * (fp * d[a] + fv * u);
+                }
+                if DF {
+                    let gamma_j = if wall { 1.0 } else { cont[j][1] };
+                    let s = terms::shepard_pressure(
+                        m_i, m_j, rho_i, rho_j, p_i, p_j, gamma_i, gamma_j, dwdr, r,
+                    );
+                    for a in 0..3 {
+                        f[a] += s * d[a];
+                    }
+                }
+                if DF && marrone {
+                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                    let s = terms::marrone_viscosity(
+                        pr, m_i, m_j, rho_i, rho_j, eta_ij, u, d, r2, dwdr, r,
+                    );
+                    for a in 0..3 {
+                        f[a] += s * d[a];
+                    }
                 }
                 if BG {
                     let fbg = terms::background_pressure(pb, dwdr, r);

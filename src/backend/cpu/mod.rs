@@ -3,6 +3,7 @@
 //! the thread count or schedule.
 
 mod bodies;
+mod continuity;
 mod density;
 mod forces;
 mod heat;
@@ -76,6 +77,12 @@ impl CpuBackend {
     }
     pub(crate) fn density(&mut self) {
         density::run(&self.params, &mut self.st, &self.grid, &mut self.list)
+    }
+    pub(crate) fn continuity_rate(&mut self) {
+        continuity::rates(&self.params, &mut self.st, &self.grid, &mut self.list)
+    }
+    pub(crate) fn continuity_update(&mut self) {
+        continuity::update(&self.params, &mut self.st)
     }
     pub(crate) fn wall(&mut self) {
         wall::run(&self.params, &mut self.st, &self.grid)

@@ -447,7 +447,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     let held = Held::of_state(st);
     for f in FIELDS
         .iter()
-        .filter(|f| f.scratch.is_some() && held.holds(f.holder))
+        .filter(|f| f.sorted_in(held))
     {
         (f.permute)(st, &perm);
     }

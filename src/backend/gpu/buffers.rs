@@ -206,7 +206,10 @@ impl Buffers {
                 .collect(),
             scratch: FIELDS
                 .iter()
-                .map(|f| f.scratch.map(|s| storage(device, s, size(f))))
+                .map(|f| {
+                    let bytes = if f.sorted_in(held) { size(f) } else { 16 };
+                    f.scratch.map(|s| storage(device, s, bytes))
+                })
                 .collect(),
             keys: storage(device, "keys", n_pad as u64 * 8),
             cell_start: storage(device, "cell_start", n_cells * 4),
@@ -277,7 +280,7 @@ impl Buffers {
     /// After the sort: each sorted field's scratch back into the field.
     pub fn copy_back_sorted(&self, enc: &mut wgpu::CommandEncoder, held: Held) {
         for (k, f) in FIELDS.iter().enumerate() {
-            if let (Some(src), true) = (&self.scratch[k], held.holds(f.holder)) {
+            if let (Some(src), true) = (&self.scratch[k], f.sorted_in(held)) {
                 let dst = &self.fields[k];
                 enc.copy_buffer_to_buffer(src, 0, dst, 0, dst.size());
             }

@@ -37,9 +37,13 @@ const LIBS: [(&str, &str); 8] = [
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
-pub const PASSES: [(&str, &str); 11] = [
+pub const PASSES: [(&str, &str); 12] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
+    (
+        "continuity",
+        include_str!("../../../shaders/continuity.wgsl"),
+    ),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
     ("forces", include_str!("../../../shaders/forces.wgsl")),
     ("integrate", include_str!("../../../shaders/integrate.wgsl")),
@@ -362,6 +366,9 @@ mod tests {
     s_vel[k] = vel[s];
     s_acc[k] = acc[s];
     s_acc_b[k] = acc_b[s];
+    if ((P.sizes.flags & FLAG_CONTINUITY) != 0u) {
+        s_rho[k] = rho[s];
+    }
     s_mass[k] = mass[s];
     s_phase[k] = phase[s];
     s_id[k] = id[s];

@@ -1,0 +1,146 @@
+//! Twin of shaders/continuity.wgsl: the δ-SPH density of R18 §3.1.2. The density
+//! is state, advanced by the continuity equation with Antuono et al.'s density
+//! diffusion written on the excess over the reference density (R18 (3.53)),
+//!   dρ_i/dt = ρ_i Σ_j V_j (u_i − u_j)·∇_iW_ij + δ h c0 Σ_j V_j ψ_ij·∇_iW_ij,
+//!   ψ_ij = 2 (ρ̄_j − ρ̄_i) (r_j − r_i)/|r_ij|²,  ρ̄ = ρ − ρ0,
+//! so ψ_ij·∇_iW_ij = −2 (ρ̄_j − ρ̄_i) (∂W/∂r)/r. R18 (3.14) prints the diffusion
+//! inside the velocity bracket, multiplied by ρ (PAPERS-EXTRACT §5.4 flags it);
+//! this is Antuono's form. Diffusing the excess, not ρ, keeps a temperature-
+//! dependent ρ0 from driving a flux (R18 §3.4). The diffusion acts between
+//! particles of the same phase only: across a liquid–gas interface a liquid's
+//! excess (1% of 7000 kg/m³) is many times the gas's whole density, and
+//! diffusing it blew the gas up within 60–150 steps (two_layer_2d,
+//! sessile_drop_2d); R18 has no gas particles, and its two-fluid column (Test 3)
+//! asks for no diffusion across the interface. c0 is the scene's largest sound speed (one δ h c0
+//! for every pair, so each pair's exchange is antisymmetric).
+//!
+//! A wall or body neighbour enters as in the forces pass: the fluid's mass and
+//! the density its EOS gives at the pressure the wall pass extrapolated; in the
+//! divergence with its real velocity (the wall phase's, or the body's at that
+//! point), not the wall pass's no-slip ghost.
+//!
+//! Γ_i = Σ_j V_j W_ij over every neighbour (R18 (3.17)'s renormalisation, read by
+//! the Shepard pressure term), 1 for walls.
+//!
+//! Time integration, in F22's kick–drift–kick step: after the drift and the
+//! sort, dρ/dt from x^{n+1}, u^{n+½} and ρ^n, then ρ^{n+1} = ρ^n + Δt dρ/dt and
+//! p = c²(ρ − ρ0). The velocity is the half step's (second order), the
+//! positions the new ones (first order in Δt; the acoustic Δt makes it
+//! negligible against the spatial error: see the check scenes). R18's leap-frog
+//! (3.55) is the same kick–drift–kick split for the velocity; keeping F22's lets
+//! every other pass (bodies, heat, the transport velocity) stay as it is.
+
+use super::neighbors::{min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK};
+use super::bodies::point_velocity;
+use super::density::equation_of_state;
+use crate::kernel;
+use crate::params::{Params, FLAG_BODIES};
+use crate::state::{State, NO_BODY};
+use rayon::prelude::*;
+
+/// The real velocity of wall or body particle j (not the wall pass's ghost).
+#[inline(always)]
+fn solid_velocity(pr: &Params, st: &State, j: usize) -> [f32; 3] {
+    if pr.flag(FLAG_BODIES) {
+        let k = st.body[st.id[j] as usize];
+        if k != NO_BODY {
+            return point_velocity(&st.bodies[k as usize], &st.pos[j]);
+        }
+    }
+    let w = pr.phase(st.phase[j]).velocity;
+    [w[0], w[1], w[2]]
+}
+
+/// (dρ/dt, Γ) of fluid particle i over the neighbours `js` (walk order).
+fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
+    let ph_i = st.phase[i];
+    let mat_i = pr.phase(ph_i);
+    let (rho_i, m_i) = (st.rho[i], st.mass[i]);
+    let excess_i = rho_i - mat_i.rho0;
+    let v_i = st.vel[i];
+    let pi = st.pos[i];
+    let (mut div, mut diff, mut gamma) = (0.0f32, 0.0f32, 0.0f32);
+    for &j in js {
+        let j = j as usize;
+        let d = min_image(pr, pi, st.pos[j]);
+        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let r = r2.sqrt();
+        let ph_j = st.phase[j];
+        if pr.is_wall(ph_j) {
+            let rho_w = mat_i.rho0 + st.press[j] / mat_i.c2;
+            let vol_w = m_i / rho_w;
+            gamma += vol_w * kernel::w(pr, r);
+            if r2 > 0.0 {
+                let u = solid_velocity(pr, st, j);
+                let ud = (v_i[0] - u[0]) * d[0] + (v_i[1] - u[1]) * d[1] + (v_i[2] - u[2]) * d[2];
+                div += vol_w * ud * (kernel::dw(pr, r) / r);
+            }
+        } else {
+            let rho_j = st.rho[j];
+            let vol_j = st.mass[j] / rho_j;
+            gamma += vol_j * kernel::w(pr, r);
+            if r2 > 0.0 {
+                let v_j = st.vel[j];
+                let f = kernel::dw(pr, r) / r;
+                let ud = (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
+                div += vol_j * ud * f;
+                if ph_j == ph_i {
+                    let excess_j = rho_j - mat_i.rho0;
+                    diff -= vol_j * (excess_j - excess_i) * f;
+                }
+            }
+        }
+    }
+    [rho_i * div + pr.solve.delta_hc * (diff + diff), gamma]
+}
+
+/// `continuity_rate`: (dρ/dt, Γ) per particle; also records each fluid
+/// particle's neighbours in `list` for the forces pass (as the density pass does).
+pub fn rates(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
+    let n = st.active();
+    let chunks = list.take_chunks(n.div_ceil(LIST_CHUNK));
+    let mut out = std::mem::take(&mut st.continuity);
+    let s: &State = st;
+    let chunks: Vec<ListChunk> = out[..n]
+        .par_chunks_mut(LIST_CHUNK)
+        .zip(chunks)
+        .enumerate()
+        .map(|(c, (rates, mut chunk))| {
+            for (k, out) in rates.iter_mut().enumerate() {
+                let i = c * LIST_CHUNK + k;
+                if pr.is_wall(s.phase[i]) {
+                    chunk.push(&[]);
+                    *out = [0.0, 1.0];
+                    continue;
+                }
+                *out = with_neighbors(pr, &s.pos, grid, i, |js, _| {
+                    chunk.push(js);
+                    rate(pr, s, i, js)
+                });
+            }
+            chunk
+        })
+        .collect();
+    st.continuity = out;
+    list.store(grid, chunks);
+}
+
+/// `continuity_update`: ρ += Δt dρ/dt and the EOS, fluid particles.
+pub fn update(pr: &Params, st: &mut State) {
+    let n = st.active();
+    let dt = st.sim.dt;
+    let (phase, rates) = (&st.phase, &st.continuity);
+    st.rho[..n]
+        .par_iter_mut()
+        .zip(st.press[..n].par_iter_mut())
+        .enumerate()
+        .for_each(|(i, (rho, p))| {
+            let ph = phase[i];
+            if pr.is_wall(ph) {
+                return;
+            }
+            let r = *rho + dt * rates[i][0];
+            *rho = r;
+            *p = equation_of_state(pr, ph, r);
+        });
+}

@@ -199,9 +199,13 @@ pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
         .fold(0.0, f64::max);
     let y_area = widest as u32 + AXIS_DESC_PX + 30;
     let plot_w = f64::from(WIDTH - y_area - 2 * 20);
-    let x_ticks = log_ticks(&xr, plot_w, |a, b| {
+    let mut x_ticks = log_ticks(&xr, plot_w, |a, b| {
         (text_w(&log_label(a), &tick_font) + text_w(&log_label(b), &tick_font)) / 2.0 + 16.0
     });
+    // A label centred on the axis' right end would run past the figure's edge
+    // (the margin is 20 pixels).
+    let x_px = |v: f64| plot_w * (v / xr.start).log10() / (xr.end / xr.start).log10();
+    x_ticks.retain(|&v| x_px(v) + text_w(&log_label(v), &tick_font) / 2.0 <= plot_w + 16.0);
     let minor = [1, 2, 3, 4, 5, 6, 7, 8, 9];
     let x_coord = xr
         .clone()
@@ -270,11 +274,25 @@ pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
         })
         .collect();
     // Point labels: each goes to the first side of its point (above right, below
-    // right, above left, below left) where it overlaps no label placed before it
-    // and no other point, and stays inside the plot; a label with no such side is
-    // left out (points of different kernels at the same Δx and cost say the same).
+    // right, above left, below left) where it overlaps no label placed before it,
+    // no other point and, if it can, no line, and stays inside the plot; a label
+    // with no such side is left out (points of different kernels at the same Δx
+    // and cost say the same).
     let label_h = f64::from(POINT_LABEL_PX);
     let points: Vec<(f64, f64)> = series_px.iter().flatten().copied().collect();
+    // The lines, sampled every few pixels: a label prefers a side no line crosses.
+    let line_samples: Vec<(f64, f64)> = series_px
+        .iter()
+        .flat_map(|px| px.windows(2))
+        .flat_map(|w| {
+            let (p, q) = (w[0], w[1]);
+            let n = ((q.0 - p.0).hypot(q.1 - p.1) / 3.0).ceil().max(1.0) as u32;
+            (0..=n).map(move |t| {
+                let t = f64::from(t) / f64::from(n);
+                (p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1))
+            })
+        })
+        .collect();
     let mut placed: Vec<[f64; 4]> = Vec::new(); // x0, y0, x1, y1
     let mut offsets: Vec<Vec<Option<(i32, i32)>>> = Vec::new();
     for (s, px) in fig.series.iter().zip(&series_px) {
@@ -291,8 +309,12 @@ pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
                 (-8.0 - w, -4.0 - label_h),
                 (-8.0 - w, 4.0),
             ];
-            let fits = |&(dx, dy): &(f64, f64)| {
+            let fits = |&(dx, dy): &(f64, f64), avoid_lines: bool| {
                 let r = [x + dx, y + dy, x + dx + w, y + dy + label_h];
+                let off_lines = !avoid_lines
+                    || line_samples
+                        .iter()
+                        .all(|&(lx, ly)| lx < r[0] || lx > r[2] || ly < r[1] || ly > r[3]);
                 let inside = r[0] >= 0.0 && r[1] >= 0.0 && r[2] <= area_w && r[3] <= area_h;
                 let clear = placed
                     .iter()
@@ -304,9 +326,11 @@ pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
                         || py < r[1] - 5.0
                         || py > r[3] + 5.0
                 });
-                inside && clear && no_point
+                inside && clear && no_point && off_lines
             };
-            let side = sides.iter().find(|s| fits(s)).copied();
+            let side = (sides.iter().find(|s| fits(s, true)))
+                .or_else(|| sides.iter().find(|s| fits(s, false)))
+                .copied();
             if let Some((dx, dy)) = side {
                 placed.push([x + dx, y + dy, x + dx + w, y + dy + label_h]);
             }

@@ -154,7 +154,38 @@ enum BenchKind {
     },
 }
 
+/// The Vulkan loader's window-system probe (libwayland) prints `error:
+/// XDG_RUNTIME_DIR is invalid or not set in the environment.` when that variable is
+/// missing, as in a fresh Debian shell or a container: a newcomer reads it as a
+/// failure. Point it at a private directory (`$TMPDIR/spatter-runtime-<uid>`, mode
+/// 0700, reused; owned by someone else, it is left alone) before any wgpu instance
+/// exists. Called first in `main`, while the process has a single thread.
+#[cfg(unix)]
+fn ensure_runtime_dir() {
+    use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+    let usable = |d: &std::path::Path| {
+        std::fs::metadata(d).is_ok_and(|m| m.is_dir() && !m.permissions().readonly())
+    };
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| usable(d.as_ref())) {
+        return;
+    }
+    let Ok(uid) = std::fs::metadata("/proc/self").map(|m| m.uid()) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("spatter-runtime-{uid}"));
+    let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    let ours = std::fs::symlink_metadata(&dir)
+        .is_ok_and(|m| m.is_dir() && m.uid() == uid && m.permissions().mode() & 0o777 == 0o700);
+    if ours {
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
+}
+
+#[cfg(not(unix))]
+fn ensure_runtime_dir() {}
+
 fn main() -> ExitCode {
+    ensure_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run {

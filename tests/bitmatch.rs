@@ -272,16 +272,21 @@ fn delta_sph_200_steps() {
     assert_bit_identical("dam_break_3d", &[DELTA, "dx=0.02"], 100);
 }
 
-/// δ-SPH with heat, melting and the line melt's forces (the main job's scene),
-/// and with rigid bodies in a walled liquid (the body pass's reaction through
-/// the Shepard pressure).
+/// δ-SPH with heat and melting, and with rigid bodies in a walled liquid (the
+/// body pass's reaction through the Shepard pressure); the line melt's forces on
+/// summation density (the main job's scene runs δ-SPH in
+/// `line_melt_with_every_force_200_steps`).
 #[test]
 fn delta_sph_with_heat_and_bodies_200_steps() {
     assert_bit_identical("melt_block_3d", &[DELTA], 100);
     assert_bit_identical("settling_disc_2d", &[DELTA], 200);
     assert_bit_identical_at(
         concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/pbf/line_melt_coarse_2d.toml"),
-        &[DELTA],
+        &[
+            "simulation.formulation=\"wcsph\"",
+            "phases.plate.temperature=1650.0",
+            "laser.power=[[0.0, 4.0e6]]",
+        ],
         200,
     );
 }
@@ -402,7 +407,7 @@ fn free_surface_tension_with_temperature_200_steps() {
 
 /// Issue 16 item 8: the line-melt scene with every force it has (the README's
 /// first command: heat, melting, the surface laser, evaporation, recoil, surface
-/// tension with Marangoni in the free-surface form), 200 steps. The plate starts
+/// tension with Marangoni in the free-surface form, on δ-SPH), 200 steps. The plate starts
 /// at 1650 K under 4e6 W/m so that within the 200 steps (14 µs) it melts and
 /// passes T_v (3359 K measured, recoil power 18 W/m): at the scene's own start
 /// nothing has melted yet by then.

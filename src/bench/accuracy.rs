@@ -14,8 +14,11 @@ use std::path::Path;
 
 /// One scene's resolution sweep.
 pub struct Sweep {
+    /// The scene's file stem, with `@variant` when `sets` change its formulation.
     pub name: &'static str,
     text: &'static str,
+    /// `--set` overrides of the variant (another formulation side by side).
+    sets: &'static [&'static str],
     /// Reference length L (m): the runs use Δx = L/n.
     length: f64,
     /// Cell counts n across L, coarse to fine; each fills the scene's boxes with
@@ -47,6 +50,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "poiseuille_2d",
         text: scene_text!("poiseuille_2d"),
+        sets: &[],
         length: 1.0e-3,
         cells: &[15, 20, 25, 30, 40],
         expected_order: Some(2.0),
@@ -56,6 +60,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "couette_2d",
         text: scene_text!("couette_2d"),
+        sets: &[],
         length: 1.0e-3,
         cells: &[15, 20, 25, 30, 40],
         expected_order: Some(2.0),
@@ -65,6 +70,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "hydrostatic_2d",
         text: scene_text!("hydrostatic_2d"),
+        sets: &[],
         length: 0.1,
         cells: &[4, 5, 8, 10],
         expected_order: Some(1.0),
@@ -74,6 +80,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "hydrostatic_3d",
         text: scene_text!("hydrostatic_3d"),
+        sets: &[],
         length: 0.1,
         cells: &[4, 5, 8],
         expected_order: Some(1.0),
@@ -83,6 +90,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "two_layer_2d",
         text: scene_text!("two_layer_2d"),
+        sets: &[],
         length: 0.1,
         cells: &[10, 16, 20, 25],
         expected_order: Some(1.0),
@@ -92,6 +100,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "laplace_disc_2d",
         text: scene_text!("laplace_disc_2d"),
+        sets: &[],
         // The disc's radius: R = 10, 20, 40 Δx.
         length: 0.02,
         cells: &[10, 20, 40],
@@ -102,16 +111,28 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "laplace_free_disc_2d",
         text: scene_text!("laplace_free_disc_2d"),
+        sets: &[],
         // The disc's radius: R = 10, 20, 40 Δx.
         length: 0.02,
         cells: &[10, 20, 40],
         expected_order: Some(1.0),
-        why: "R18's free-surface CSF would be 1st order like the gas form; today the surface row compacts under summation density and the error grows",
+        why: "R18's free-surface CSF on δ-SPH (the scene's formulation): 1st order like the gas form, until the density diffusion's free-surface instability (40 dx)",
+        quick: false,
+    },
+    Sweep {
+        name: "laplace_free_disc_2d@wcsph",
+        text: scene_text!("laplace_free_disc_2d"),
+        sets: &["simulation.formulation=\"wcsph\""],
+        length: 0.02,
+        cells: &[10, 20, 40],
+        expected_order: Some(1.0),
+        why: "the same disc on summation density: the surface row compacts and the error grows",
         quick: false,
     },
     Sweep {
         name: "square_drop_2d",
         text: scene_text!("square_drop_2d"),
+        sets: &[],
         // dx = 4, 2, 1 mm (divisors of the 0.08 m period): the square's side is
         // 8, 16, 31 particles.
         length: 0.04,
@@ -123,6 +144,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "thermocapillary_2d",
         text: scene_text!("thermocapillary_2d"),
+        sets: &[],
         // The liquid layer's thickness a: 10, 20, 40 Δx (the 1 mm period 40,
         // 80, 160 Δx).
         length: 2.5e-4,
@@ -134,6 +156,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "conduction_1d",
         text: scene_text!("conduction_1d"),
+        sets: &[],
         length: 0.01,
         // Periodic in x: at least three quintic supports (9 Δx) across.
         cells: &[10, 12, 14, 16],
@@ -144,6 +167,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "conduction_two_materials",
         text: scene_text!("conduction_two_materials"),
+        sets: &[],
         length: 0.02,
         // Periodic in x (at least 9 Δx across); n even puts the material jump on a row gap.
         cells: &[10, 12, 14, 16],
@@ -154,6 +178,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "stefan_1d",
         text: scene_text!("stefan_1d"),
+        sets: &[],
         length: 0.04,
         cells: &[20, 25, 32, 40, 50],
         expected_order: Some(1.0),
@@ -163,6 +188,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "rosenthal_2d",
         text: scene_text!("rosenthal_2d"),
+        sets: &[],
         length: 2.0e-4,
         cells: &[4, 5, 8, 10],
         expected_order: Some(2.0),
@@ -172,6 +198,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "laser_flat_plate",
         text: scene_text!("laser_flat_plate"),
+        sets: &[],
         length: 2.0e-4,
         cells: &[10, 16, 20, 25],
         expected_order: None,
@@ -181,6 +208,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "recoil_layer_2d",
         text: scene_text!("recoil_layer_2d"),
+        sets: &[],
         // The hot half of the layer: 5, 10, 20 rows.
         length: 5.0e-5,
         cells: &[5, 10, 20],
@@ -280,11 +308,13 @@ fn chosen(opts: &Options) -> Result<Vec<&'static Sweep>, SpatterError> {
 
 fn load(sw: &Sweep, kernel: KernelKind, cells: u32) -> Result<Loaded, SpatterError> {
     let dx = sw.length / cells as f64;
-    let sets = [
+    let mut sets = vec![
         format!("dx={dx:e}"),
         format!("kernel={}", kernel_key(kernel)),
     ];
-    let label = format!("scenarios/validation/{}.toml", sw.name);
+    sets.extend(sw.sets.iter().map(|s| s.to_string()));
+    let stem = sw.name.split('@').next().unwrap_or(sw.name);
+    let label = format!("scenarios/validation/{stem}.toml");
     Ok(run::load_str(&label, sw.text, &sets)?)
 }
 

@@ -1,9 +1,10 @@
 // uses: params consts kernel grid phase rigid
 // reads: pos vel mass phase id body bodies sim
-// writes: rho press continuity
-// δ-SPH density (R18 §3.1.2, (3.14) with the diffusion (3.53)): the continuity
-// equation's rate and Shepard sum (continuity_rate), then rho += dt drho/dt and
-// the EOS (continuity_update). Twin of src/backend/cpu/continuity.rs (equations
+// writes: rho press continuity density_gradient
+// δ-SPH density (R18 §3.1.2, (3.14) with the diffusion (3.53) and its
+// renormalisation f_l): the excess density's gradient (continuity_gradient),
+// the continuity equation's rate and Shepard sum (continuity_rate), then
+// rho += dt drho/dt and the EOS (continuity_update). Twin of src/backend/cpu/continuity.rs (equations
 // and choices there).
 
 // The EOS p = c²(rho - rho0), clamped at 0 with the pressure floor: the density
@@ -27,6 +28,74 @@ fn solid_velocity(j: u32) -> vec3<f32> {
     return P.phases[phase[j]].velocity.xyz;
 }
 
+// The renormalised gradient of the excess density over the particle's own
+// phase (Antuono et al. 2010): <grad rho_bar>_i = M_i^-1 b_i with
+// M_i = sum_j V_j (r_j - r_i) (x) grad_i W_ij (symmetric) and
+// b_i = sum_j V_j (rho_bar_j - rho_bar_i) grad_i W_ij; 0 where M is near
+// singular (|det| <= 1e-3: a particle with few neighbours of its phase).
+@compute @workgroup_size(64)
+fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let ph_i = phase[i];
+    if (is_wall(ph_i)) {
+        density_gradient[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        return;
+    }
+    let rho0_i = P.phases[ph_i].rho0;
+    let excess_i = rho[i] - rho0_i;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var mxx = 0.0;
+    var mxy = 0.0;
+    var mxz = 0.0;
+    var myy = 0.0;
+    var myz = 0.0;
+    var mzz = 0.0;
+    var b = vec3<f32>(0.0);
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kernel.support2 && r2 > 0.0 && phase[j] == ph_i) {
+            let r = sqrt(r2);
+            let vf = mass[j] / rho[j] * (kernel_dw(r) / r);
+            mxx = mxx - vf * d.x * d.x;
+            mxy = mxy - vf * d.x * d.y;
+            mxz = mxz - vf * d.x * d.z;
+            myy = myy - vf * d.y * d.y;
+            myz = myz - vf * d.y * d.z;
+            mzz = mzz - vf * d.z * d.z;
+            let db = (rho[j] - rho0_i - excess_i) * vf;
+            b.x = b.x + db * d.x;
+            b.y = b.y + db * d.y;
+            b.z = b.z + db * d.z;
+        }
+    }
+    var g = vec3<f32>(0.0);
+    if (P.sizes.dim == 2u) {
+        let det = mxx * myy - mxy * mxy;
+        if (abs(det) > 1.0e-3) {
+            g.x = (myy * b.x - mxy * b.y) / det;
+            g.y = (mxx * b.y - mxy * b.x) / det;
+        }
+    } else {
+        let c00 = myy * mzz - myz * myz;
+        let c01 = mxz * myz - mxy * mzz;
+        let c02 = mxy * myz - mxz * myy;
+        let c11 = mxx * mzz - mxz * mxz;
+        let c12 = mxy * mxz - mxx * myz;
+        let c22 = mxx * myy - mxy * mxy;
+        let det = mxx * c00 + mxy * c01 + mxz * c02;
+        if (abs(det) > 1.0e-3) {
+            g.x = (c00 * b.x + c01 * b.y + c02 * b.z) / det;
+            g.y = (c01 * b.x + c11 * b.y + c12 * b.z) / det;
+            g.z = (c02 * b.x + c12 * b.y + c22 * b.z) / det;
+        }
+    }
+    density_gradient[i] = vec4<f32>(g, 0.0);
+}
+
 @compute @workgroup_size(64)
 fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -41,6 +110,7 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     let rho0_i = P.phases[ph_i].rho0;
     let c2_i = P.phases[ph_i].c2;
     let excess_i = rho_i - rho0_i;
+    let g_i = density_gradient[i];
     let v_i = vel[i];
     let pi = pos[i];
     let ci = cell_coord(pi);
@@ -73,14 +143,16 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
                     let ud = (v_i.x - v_j.x) * d.x + (v_i.y - v_j.y) * d.y + (v_i.z - v_j.z) * d.z;
                     div = div + vol_j * ud * f;
                     if (ph_j == ph_i) {
-                        let excess_j = rho_j - rho0_i;
-                        diff = diff - vol_j * (excess_j - excess_i) * f;
+                        let dr = rho_j - rho0_i - excess_i;
+                        let gj = density_gradient[j];
+                        let gd = (g_i.x + gj.x) * d.x + (g_i.y + gj.y) * d.y + (g_i.z + gj.z) * d.z;
+                        diff = diff - vol_j * (dr + dr + gd) * f;
                     }
                 }
             }
         }
     }
-    let rate = rho_i * div + P.solve.delta_hc * (diff + diff);
+    let rate = rho_i * div + P.solve.delta_hc * diff;
     continuity[i] = vec2<f32>(rate, gamma);
 }
 

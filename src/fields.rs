@@ -160,7 +160,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 15] = [
+pub const FIELDS: [FieldDef; 16] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -193,6 +193,10 @@ pub const FIELDS: [FieldDef; 15] = [
     // after the sort.
     field!("continuity", continuity, "continuity", None, 2, 1, true, Holder::Continuity,
         None),
+    // δ-SPH: the renormalised gradient of rho - rho0 (xyz) for the diffusion's
+    // correction, written by the continuity pass every step after the sort.
+    field!("density_gradient", density_gradient, "density_gradient", None, 4, 1, true,
+        Holder::Continuity, None),
     // Written by heat.begin every step after the sort (no scratch needed).
     field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
         None),

@@ -351,6 +351,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     }
     if held.continuity {
         st.continuity = vec![[0.0, 1.0]; st.len()];
+        st.density_gradient = vec![[0.0; 4]; st.len()];
     }
     if held.solvers {
         st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];

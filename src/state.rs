@@ -71,6 +71,8 @@ pub struct State {
     /// δ-SPH only (empty otherwise): dρ/dt of the continuity equation and the
     /// Shepard sum Γ of the particle's support.
     pub continuity: Vec<[f32; 2]>,
+    /// δ-SPH only: the renormalised gradient ⟨∇ρ̄⟩^L (xyz) of the excess density.
+    pub density_gradient: Vec<[f32; 4]>,
     /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser
     /// source of the step, the first iteration's rate ḣ_0 and the last
     /// iteration's |ḣ_k − ḣ_{k−1}|.

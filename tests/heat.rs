@@ -334,12 +334,11 @@ fn particles_without_a_temperature_write_the_ambient_temperature() {
 /// coarse 2D line melt with surface tension, Marangoni and recoil runs to its end
 /// (no watchdog stop), writes an MCAP whose /track `tools/spatter_read.py track`
 /// plots, and prints the melt pool and the track. F22 §4.5 reports only shapes:
-/// the hottest melt passes T_v = 3000 K (measured 3396 K), the remelt depth is
-/// largest where the scan starts (measured 13.9 against 13.6 µm, means of the
-/// first and last tenth of the track: a 2% margin on δ-SPH, 19.9 against 10.9 on
-/// summation density), and the resolidified surface ends below the initial one
-/// (measured −4.9 µm on average: the 2D slice also loses the 5 particles that
-/// splash out).
+/// the hottest melt passes T_v = 3000 K (measured 3554 K), the remelt depth is
+/// largest where the scan starts (measured 23.7 against 9.2 µm, means of the
+/// first and last tenth of the track; 19.9 against 10.9 on summation density),
+/// and the resolidified surface ends below the initial one (measured −9.0 µm on
+/// average: the 2D slice also loses the 35 particles that splash out).
 #[test]
 fn coarse_line_melt_main_job() {
     let dir = common::scratch("coarse_line_melt");

@@ -238,6 +238,7 @@ pub const STAGES: [StageDef; 20] = [
         file: "continuity",
         needed: |f| f.fluid && f.continuity,
         dispatches: &[
+            always("continuity_gradient", Work::Particles, |b| b.continuity_gradient()),
             always("continuity_rate", Work::Particles, |b| b.continuity_rate()),
             always("continuity_update", Work::Particles, |b| b.continuity_update()),
         ],

@@ -2,8 +2,10 @@
 //! is state, advanced by the continuity equation with Antuono et al.'s density
 //! diffusion written on the excess over the reference density (R18 (3.53)),
 //!   dρ_i/dt = ρ_i Σ_j V_j (u_i − u_j)·∇_iW_ij + δ h c0 Σ_j V_j ψ_ij·∇_iW_ij,
-//!   ψ_ij = 2 (ρ̄_j − ρ̄_i) (r_j − r_i)/|r_ij|²,  ρ̄ = ρ − ρ0,
-//! so ψ_ij·∇_iW_ij = −2 (ρ̄_j − ρ̄_i) (∂W/∂r)/r. R18 (3.14) prints the diffusion
+//!   ψ_ij = 2 (ρ̄_j − ρ̄_i) (r_j − r_i)/|r_ij|² − (⟨∇ρ̄⟩_i + ⟨∇ρ̄⟩_j),  ρ̄ = ρ − ρ0,
+//! so ψ_ij·∇_iW_ij = −(2 (ρ̄_j − ρ̄_i) + (⟨∇ρ̄⟩_i + ⟨∇ρ̄⟩_j)·r_ij) (∂W/∂r)/r, with
+//! Antuono et al. (2010)'s renormalised gradient (`gradients`; R18's optional
+//! f_l). R18 (3.14) prints the diffusion
 //! inside the velocity bracket, multiplied by ρ (PAPERS-EXTRACT §5.4 flags it);
 //! this is Antuono's form. Diffusing the excess, not ρ, keeps a temperature-
 //! dependent ρ0 from driving a flux (R18 §3.4). The diffusion acts between
@@ -30,7 +32,9 @@
 //! (3.55) is the same kick–drift–kick split for the velocity; keeping F22's lets
 //! every other pass (bodies, heat, the transport velocity) stay as it is.
 
-use super::neighbors::{min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK};
+use super::neighbors::{
+    for_each_neighbor, min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
+};
 use super::bodies::point_velocity;
 use super::density::equation_of_state;
 use crate::kernel;
@@ -51,12 +55,84 @@ fn solid_velocity(pr: &Params, st: &State, j: usize) -> [f32; 3] {
     [w[0], w[1], w[2]]
 }
 
+/// `continuity_gradient`: the renormalised gradient of the excess density over
+/// the particle's own phase (Antuono et al. 2010, the f_l of R18 (3.53)),
+///   ⟨∇ρ̄⟩_i = M_i⁻¹ Σ_j V_j (ρ̄_j − ρ̄_i) ∇_iW_ij,  M_i = Σ_j V_j (r_j − r_i) ⊗ ∇_iW_ij,
+/// so that ψ_ij·∇_iW_ij vanishes for a linear ρ̄ (a hydrostatic column, or the
+/// truncated support at a free surface, where the plain term diffuses towards
+/// the surface). 0 where |det M| ≤ 1e-3 (M ≈ I in a full support).
+pub fn gradients(pr: &Params, st: &mut State, grid: &CellTable) {
+    let n = st.active();
+    let s: &State = st;
+    let out: Vec<[f32; 4]> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let ph_i = s.phase[i];
+            if pr.is_wall(ph_i) {
+                return [0.0; 4];
+            }
+            let rho0_i = pr.phase(ph_i).rho0;
+            let excess_i = s.rho[i] - rho0_i;
+            let (mut m, mut b) = ([0.0f32; 6], [0.0f32; 3]);
+            for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+                if r2 <= 0.0 || s.phase[j] != ph_i {
+                    return;
+                }
+                let r = r2.sqrt();
+                let vf = s.mass[j] / s.rho[j] * (kernel::dw(pr, r) / r);
+                m[0] -= vf * d[0] * d[0];
+                m[1] -= vf * d[0] * d[1];
+                m[2] -= vf * d[0] * d[2];
+                m[3] -= vf * d[1] * d[1];
+                m[4] -= vf * d[1] * d[2];
+                m[5] -= vf * d[2] * d[2];
+                let db = (s.rho[j] - rho0_i - excess_i) * vf;
+                for a in 0..3 {
+                    b[a] += db * d[a];
+                }
+            });
+            let g = solve_symmetric(pr.sizes.dim, m, b);
+            [g[0], g[1], g[2], 0.0]
+        })
+        .collect();
+    st.density_gradient[..n].copy_from_slice(&out);
+}
+
+/// M g = b for the symmetric M = (xx, xy, xz, yy, yz, zz), by cofactors (the
+/// 2×2 block in 2D); 0 where |det M| ≤ 1e-3.
+fn solve_symmetric(dim: u32, m: [f32; 6], b: [f32; 3]) -> [f32; 3] {
+    let [xx, xy, xz, yy, yz, zz] = m;
+    let mut g = [0.0f32; 3];
+    if dim == 2 {
+        let det = xx * yy - xy * xy;
+        if det.abs() > 1.0e-3 {
+            g[0] = (yy * b[0] - xy * b[1]) / det;
+            g[1] = (xx * b[1] - xy * b[0]) / det;
+        }
+        return g;
+    }
+    let c00 = yy * zz - yz * yz;
+    let c01 = xz * yz - xy * zz;
+    let c02 = xy * yz - xz * yy;
+    let c11 = xx * zz - xz * xz;
+    let c12 = xy * xz - xx * yz;
+    let c22 = xx * yy - xy * xy;
+    let det = xx * c00 + xy * c01 + xz * c02;
+    if det.abs() > 1.0e-3 {
+        g[0] = (c00 * b[0] + c01 * b[1] + c02 * b[2]) / det;
+        g[1] = (c01 * b[0] + c11 * b[1] + c12 * b[2]) / det;
+        g[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det;
+    }
+    g
+}
+
 /// (dρ/dt, Γ) of fluid particle i over the neighbours `js` (walk order).
 fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
     let ph_i = st.phase[i];
     let mat_i = pr.phase(ph_i);
     let (rho_i, m_i) = (st.rho[i], st.mass[i]);
     let excess_i = rho_i - mat_i.rho0;
+    let g_i = st.density_gradient[i];
     let v_i = st.vel[i];
     let pi = st.pos[i];
     let (mut div, mut diff, mut gamma) = (0.0f32, 0.0f32, 0.0f32);
@@ -85,13 +161,15 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
                 let ud = (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
                 div += vol_j * ud * f;
                 if ph_j == ph_i {
-                    let excess_j = rho_j - mat_i.rho0;
-                    diff -= vol_j * (excess_j - excess_i) * f;
+                    let dr = rho_j - mat_i.rho0 - excess_i;
+                    let g_j = st.density_gradient[j];
+                    let gd = (g_i[0] + g_j[0]) * d[0] + (g_i[1] + g_j[1]) * d[1] + (g_i[2] + g_j[2]) * d[2];
+                    diff -= vol_j * (dr + dr + gd) * f;
                 }
             }
         }
     }
-    [rho_i * div + pr.solve.delta_hc * (diff + diff), gamma]
+    [rho_i * div + pr.solve.delta_hc * diff, gamma]
 }
 
 /// `continuity_rate`: (dρ/dt, Γ) per particle; also records each fluid

@@ -78,6 +78,9 @@ impl CpuBackend {
     pub(crate) fn density(&mut self) {
         density::run(&self.params, &mut self.st, &self.grid, &mut self.list)
     }
+    pub(crate) fn continuity_gradient(&mut self) {
+        continuity::gradients(&self.params, &mut self.st, &self.grid)
+    }
     pub(crate) fn continuity_rate(&mut self) {
         continuity::rates(&self.params, &mut self.st, &self.grid, &mut self.list)
     }

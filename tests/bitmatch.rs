@@ -260,9 +260,9 @@ const DELTA: &str = "simulation.formulation=\"delta_wcsph\"";
 /// against walls, liquid under gas at density ratio 1000, the free-surface
 /// tension disc, and R18 (3.18)'s viscosity option in a channel.
 #[test]
-fn delta_sph_200_steps() {
-    assert_bit_identical("dam_break_2d", &[DELTA], 200);
-    assert_bit_identical("two_layer_ratio1000_2d", &[DELTA], 200);
+fn delta_sph_2d_and_3d() {
+    assert_bit_identical("dam_break_2d", &[DELTA], 100);
+    assert_bit_identical("two_layer_ratio1000_2d", &[DELTA], 100);
     assert_bit_identical("laplace_free_disc_2d", &[DELTA], 200);
     assert_bit_identical(
         "poiseuille_2d",
@@ -277,9 +277,9 @@ fn delta_sph_200_steps() {
 /// summation density (the main job's scene runs δ-SPH in
 /// `line_melt_with_every_force_200_steps`).
 #[test]
-fn delta_sph_with_heat_and_bodies_200_steps() {
+fn delta_sph_with_heat_and_bodies() {
     assert_bit_identical("melt_block_3d", &[DELTA], 100);
-    assert_bit_identical("settling_disc_2d", &[DELTA], 200);
+    assert_bit_identical("settling_disc_2d", &[DELTA], 100);
     assert_bit_identical_at(
         concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/pbf/line_melt_coarse_2d.toml"),
         &[

@@ -144,7 +144,7 @@ fn body_forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             if (TERM_SOLID_FLUID_VISCOSITY) {
                 // F22 (33) as the forces pass applies it between the melt and a
                 // wall: the fluid's own alpha^sf, mass and sound speed.
-                let alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j].y);
+                let alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j][H_TEMPERATURE]);
                 let alpha = (alpha_j + alpha_j) * c_half();
                 let c2_j = P.phases[ph_j].c2;
                 let s = solid_fluid_viscosity(m_j, m_j, rho_j, rho_w, c2_j, c2_j, v_j.xyz - v_r.xyz, dj, r2, dwdr, alpha);

@@ -37,7 +37,7 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     // two_layer_ratio1000_2d differed from the CPU twin by 2 ULP at step 48, as if
     // α_0 had been factored out of α_i + α_j (the CPU multiplies each).
     if (TERM_INTERFACE_VISCOSITY && P.flow.interface_viscosity > 0.0) {
-        alpha_i = interface_viscosity_alpha(surface[i].w);
+        alpha_i = interface_viscosity_alpha(surface[i][S_DELTA]);
     }
     var gamma_i = c_one();
     if (TERM_SHEPARD_PRESSURE) {
@@ -45,7 +45,7 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     }
     var alpha_sf_i = 0.0;
     if (TERM_SOLID_FLUID_VISCOSITY) {
-        alpha_sf_i = solid_fluid_viscosity_alpha(phase[i], heat[i].y);
+        alpha_sf_i = solid_fluid_viscosity_alpha(phase[i], heat[i][H_TEMPERATURE]);
     }
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
@@ -106,7 +106,7 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                 }
             }
             if (TERM_INTERFACE_VISCOSITY && !wall) {
-                let alpha = (alpha_i + interface_viscosity_alpha(surface[j].w)) * c_half();
+                let alpha = (alpha_i + interface_viscosity_alpha(surface[j][S_DELTA])) * c_half();
                 let s = interface_viscosity(m_i, m_j, rho_i, rho_j, c2_i, P.phases[ph_j].c2, v_i.xyz - v_j.xyz, d, r2, dwdr, alpha);
                 for (var a = 0u; a < 3u; a++) {
                     f[a] = f[a] + s * d[a];
@@ -116,7 +116,7 @@ fn forces(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
                 var alpha_j = alpha_sf_i;
                 var c2_j = c2_i;
                 if (!wall) {
-                    alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j].y);
+                    alpha_j = solid_fluid_viscosity_alpha(ph_j, heat[j][H_TEMPERATURE]);
                     c2_j = P.phases[ph_j].c2;
                 }
                 let alpha = (alpha_sf_i + alpha_j) * c_half();

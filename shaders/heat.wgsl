@@ -41,15 +41,15 @@ fn mirror_temperature(i: u32) {
         if (r2 < P.kernel.support2 && conducts(phase[j])) {
             let wk = kernel_w(sqrt(r2));
             sw = sw + wk;
-            stw = stw + heat[j].y * wk;
+            stw = stw + heat[j][H_TEMPERATURE] * wk;
         }
     }
     var hv = heat[i];
-    let t_wall = hv.x;
+    let t_wall = hv[H_ENTHALPY];
     if (sw > 0.0) {
-        hv.y = c_two() * t_wall - stw / sw;
+        hv[H_TEMPERATURE] = c_two() * t_wall - stw / sw;
     } else {
-        hv.y = t_wall;
+        hv[H_TEMPERATURE] = t_wall;
     }
     heat[i] = hv;
 }
@@ -59,8 +59,8 @@ fn mirror_temperature(i: u32) {
 // minus the surface losses.
 fn conduction_rate(i: u32, laser_source: f32) -> f32 {
     let ph_i = phase[i];
-    let k_i = conductivity(ph_i, heat[i].z);
-    let t_i = heat[i].y;
+    let k_i = conductivity(ph_i, heat[i][H_LIQUID]);
+    let t_i = heat[i][H_TEMPERATURE];
     let eta2 = P.kernel.eta2;
     let pi = pos[i];
     let ci = cell_coord(pi);
@@ -72,7 +72,7 @@ fn conduction_rate(i: u32, laser_source: f32) -> f32 {
         let ph_j = phase[j];
         var k_ij = 0.0;
         if (conducts(ph_j)) {
-            let k_j = conductivity(ph_j, heat[j].z);
+            let k_j = conductivity(ph_j, heat[j][H_LIQUID]);
             // Ordered operands: both sides of a pair get the same bits.
             k_ij = c_four() * min(k_i, k_j) * max(k_i, k_j) / (k_i + k_j);
         } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
@@ -83,7 +83,7 @@ fn conduction_rate(i: u32, laser_source: f32) -> f32 {
         let r = sqrt(r2);
         let f = kernel_dw(r) * r / (r2 + eta2);
         let v_j = mass[j] / heat_density(ph_j, j);
-        sum = sum + v_j * k_ij * (t_i - heat[j].y) * f;
+        sum = sum + v_j * k_ij * (t_i - heat[j][H_TEMPERATURE]) * f;
     }
     var source = laser_source;
     if ((P.sizes.flags & FLAG_VISCOUS_HEATING) != 0u) {
@@ -91,7 +91,7 @@ fn conduction_rate(i: u32, laser_source: f32) -> f32 {
     }
     var loss = 0.0;
     if ((P.sizes.flags & FLAG_INTERFACE) != 0u) {
-        loss = surface_loss(ph_i, t_i, surface[i].w);
+        loss = surface_loss(ph_i, t_i, surface[i][S_DELTA]);
     }
     return source - loss + sum / heat_density(ph_i, i);
 }
@@ -99,7 +99,7 @@ fn conduction_rate(i: u32, laser_source: f32) -> f32 {
 // The laser pass left its source (W/kg) in heat.w.
 fn laser_source(i: u32) -> f32 {
     if (P.laser.model != 0u) {
-        return heat[i].w;
+        return heat[i][H_RATE];
     }
     return 0.0;
 }
@@ -112,8 +112,8 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let rate = conduction_rate(i, laser_source(i));
     // Neighbours read only T (.y), so the enthalpy can be updated in place.
     var hv = heat[i];
-    hv.x = hv.x + sim.dt * rate;
-    hv.w = rate;
+    hv[H_ENTHALPY] = hv[H_ENTHALPY] + sim.dt * rate;
+    hv[H_RATE] = rate;
     heat[i] = hv;
 }
 
@@ -130,8 +130,8 @@ fn heat_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if (i >= active_particles()) { return; }
     if (conducts(phase[i])) {
         var hv = heat[i];
-        heat_start[i] = vec4<f32>(hv.x, laser_source(i), 0.0, 0.0);
-        hv.w = 0.0;
+        heat_start[i] = vec4<f32>(hv[H_ENTHALPY], laser_source(i), 0.0, 0.0);
+        hv[H_RATE] = 0.0;
         heat[i] = hv;
     } else {
         heat_start[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
@@ -151,9 +151,9 @@ fn iterate_temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     var hv = heat[i];
-    let tf = temperature_of(ph, hv.x);
-    hv.y = tf.x;
-    hv.z = tf.y;
+    let tf = temperature_of(ph, hv[H_ENTHALPY]);
+    hv[H_TEMPERATURE] = tf.x;
+    hv[H_LIQUID] = tf.y;
     heat[i] = hv;
 }
 
@@ -181,9 +181,9 @@ fn iterate_conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     if (solvers[SOLVER_HEAT].iterations == 0u) {
         hs.z = rate;
     }
-    hs.w = abs(rate - hv.w);
-    hv.x = hs.x + sim.dt * ((hs.z + rate) * c_half());
-    hv.w = rate;
+    hs.w = abs(rate - hv[H_RATE]);
+    hv[H_ENTHALPY] = hs.x + sim.dt * ((hs.z + rate) * c_half());
+    hv[H_RATE] = rate;
     heat_start[i] = hs;
     heat[i] = hv;
 }
@@ -212,7 +212,7 @@ fn heat_residual(@builtin(local_invocation_index) t: u32, @builtin(workgroup_id)
     var m = vec2<f32>(0.0, 0.0);
     if (i < active_particles() && conducts(phase[i])) {
         let hs = heat_start[i];
-        m = vec2<f32>(hs.w, abs(hs.z + heat[i].w));
+        m = vec2<f32>(hs.w, abs(hs.z + heat[i][H_RATE]));
     }
     hred[t] = m;
     heat_tree_max(t);
@@ -288,17 +288,17 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (!conducts(ph)) { return; }
     let flags = heat_flags(ph);
     var hv = heat[i];
-    let tf = temperature_of(ph, hv.x);
-    hv.y = tf.x;
-    hv.z = tf.y;
+    let tf = temperature_of(ph, hv[H_ENTHALPY]);
+    hv[H_TEMPERATURE] = tf.x;
+    hv[H_LIQUID] = tf.y;
     heat[i] = hv;
     // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).
     let switch_to = (flags >> HEAT_SWITCH_SHIFT) & 15u;
     if (switch_to == 0u) { return; }
     let solid = P.phases[ph].kind == KIND_SOLID;
-    if (solid && hv.z >= 0.5) {
+    if (solid && hv[H_LIQUID] >= 0.5) {
         phase[i] = switch_to - 1u;
-    } else if (!solid && hv.z < 0.5) {
+    } else if (!solid && hv[H_LIQUID] < 0.5) {
         phase[i] = switch_to - 1u;
         vel[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         acc[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);

@@ -71,7 +71,7 @@ fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // Mushy-zone sink J22 (12): v / (1 + dt C (1 - f_l)), semi-implicit.
     let sink = P.phases[phase[i]].mushy_damping;
     if (sink > 0.0) {
-        let damp = c_one() + sim.dt * sink * (c_one() - heat[i].z);
+        let damp = c_one() + sim.dt * sink * (c_one() - heat[i][H_LIQUID]);
         for (var c = 0u; c < 3u; c++) {
             v[c] = v[c] / damp;
         }

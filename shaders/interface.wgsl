@@ -3,7 +3,7 @@
 // writes: surface
 // Interface normal and surface delta of the condensed material, R18 (3.25)-(3.27).
 // Twin of src/backend/cpu/interface.rs (equations there). surface[i] = (n, delta),
-// surface[n + i].x = Shepard sum Gamma_i.
+// surface[n + i][S_SHEPARD] = Shepard sum Gamma_i.
 
 fn condensed(ph: u32) -> bool {
     return P.phases[ph].kind != KIND_GAS;
@@ -93,7 +93,7 @@ fn solid_weight(j: u32) -> f32 {
     if (P.tension.inv_ramp_width == 0.0 || !conducts(phase[j])) {
         return c_one();
     }
-    return c_one() - min(max((heat[j].y - P.tension.t_melt) * P.tension.inv_ramp_width + c_one(), 0.0), c_one());
+    return c_one() - min(max((heat[j][H_TEMPERATURE] - P.tension.t_melt) * P.tension.inv_ramp_width + c_one(), 0.0), c_one());
 }
 
 // Wetting by a prescribed normal, F22 (27)-(29) (the CPU twin explains it). It
@@ -164,7 +164,7 @@ fn wetting(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (i >= active_particles()) { return; }
     let ph = phase[i];
     let n_i = surface[i];
-    if (n_i.w == 0.0 || (ph != P.tension.liquid && ph != P.tension.gas)) { return; }
+    if (n_i[S_DELTA] == 0.0 || (ph != P.tension.liquid && ph != P.tension.gas)) { return; }
     surface[i] = wet(i, n_i);
 }
 
@@ -182,7 +182,7 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }
-    let gamma_i = surface[n + i].x;
+    let gamma_i = surface[n + i][S_SHEPARD];
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
@@ -192,7 +192,7 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         let r2 = len2(d);
         if (r2 >= P.kernel.support2 || r2 <= 0.0 || !condensed(phase[j])) { continue; }
         let r = sqrt(r2);
-        let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j].x) * kernel_dw(r) / r;
+        let f = volume(j) * (c_one() / gamma_i + c_one() / surface[n + j][S_SHEPARD]) * kernel_dw(r) / r;
         g.x = g.x + f * d.x;
         g.y = g.y + f * d.y;
         g.z = g.z + f * d.z;

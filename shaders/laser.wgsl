@@ -130,9 +130,9 @@ fn laser_deposit(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     if (absorbs(ph)) {
-        heat[i].w = binned_source(i, ph);
+        heat[i][H_RATE] = binned_source(i, ph);
     } else {
-        heat[i].w = 0.0;
+        heat[i][H_RATE] = 0.0;
     }
 }
 
@@ -177,12 +177,12 @@ fn laser_surface(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let ph = phase[i];
     if (!conducts(ph)) { return; }
     if (!absorbs(ph)) {
-        heat[i].w = 0.0;
+        heat[i][H_RATE] = 0.0;
         return;
     }
     let up = P.sizes.dim - 1u;
     let s = surface[i];
     let cosine = max(s[up], 0.0);
     let q = irradiance(pos[i], beam_centre(sim.time), beam_power(sim.time));
-    heat[i].w = q * cosine * s.w / P.phases[ph].rho0;
+    heat[i][H_RATE] = q * cosine * s[S_DELTA] / P.phases[ph].rho0;
 }

@@ -4,7 +4,7 @@
 // Forces at the interface, added to the acceleration the forces pass wrote:
 // surface_tension, CSF with Marangoni stress F22 (24)-(26), (8), (21) between the
 // liquid and the gas of P.tension (curvature kappa_i, Morris 2000 / F22 (25), to
-// surface[n + i].y), or in the free-surface form (R18 3.1.1-3.1.2) its raw
+// surface[n + i][S_CURVATURE]), or in the free-surface form (R18 3.1.1-3.1.2) its raw
 // curvature (tension_curvature) then the smoothed curvature and force
 // (tension_smooth); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
 // (equations and choices there).
@@ -26,7 +26,7 @@ fn tension_temperature(j: u32) -> f32 {
     if ((P.sizes.flags & FLAG_HEAT) == 0u) {
         return 0.0;
     }
-    return heat[j].y;
+    return heat[j][H_TEMPERATURE];
 }
 
 // Carries a temperature for the gradient F22 (26): conducting, or a Dirichlet wall.
@@ -52,8 +52,8 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     if (!in_tension_pair(ph_i)) { return; }
     let liquid_i = ph_i == P.tension.liquid;
     let s_i = surface[i];
-    if (s_i.w == 0.0) {
-        surface[n + i].y = 0.0;
+    if (s_i[S_DELTA] == 0.0) {
+        surface[n + i][S_CURVATURE] = 0.0;
         return;
     }
     let heated = (P.sizes.flags & FLAG_HEAT) != 0u;
@@ -71,7 +71,7 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
             let ph_j = phase[j];
             let r = sqrt(r2);
             let s_j = surface[j];
-            if (in_tension_pair(ph_j) && s_j.w != 0.0) {
+            if (in_tension_pair(ph_j) && s_j[S_DELTA] != 0.0) {
                 let v_j = mass[j] / rho[j];
                 let fv = tension_ramp(tension_temperature(j)) * v_j;
                 den = den + fv * kernel_w(r);
@@ -85,7 +85,7 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
                 }
             }
             if (heated && r2 > 0.0 && has_temperature(ph_j)) {
-                let g = tension_volume(j) * (heat[j].y - t_i) * kernel_dw(r) / r;
+                let g = tension_volume(j) * (heat[j][H_TEMPERATURE] - t_i) * kernel_dw(r) / r;
                 gt.x = gt.x + g * d.x;
                 gt.y = gt.y + g * d.y;
                 gt.z = gt.z + g * d.z;
@@ -96,7 +96,7 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     if (den > 0.0) {
         kappa = -(num / den);
     }
-    surface[n + i].y = kappa;
+    surface[n + i][S_CURVATURE] = kappa;
     if (!liquid_i) { return; }
     var a = acc[i];
     a = vec4<f32>(a.xyz + tension_force(s_i, t_i, kappa, gt, rho[i]), a.w);
@@ -114,7 +114,7 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
         alpha = P.tension.alpha_min;
         slope = 0.0;
     }
-    let delta = s_i.w;
+    let delta = s_i[S_DELTA];
     let nt = s_i.x * gt.x + s_i.y * gt.y + s_i.z * gt.z;
     let tx = gt.x - nt * s_i.x;
     let ty = gt.y - nt * s_i.y;
@@ -130,7 +130,7 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
 
 // Free-surface form, first dispatch, R18 (3.28)-(3.29): raw Morris curvature
 // over the liquid's particles with a normal, weights V delta (V = m / rho0),
-// capped at |kappa| <= 1/support; to surface[n + i].z (the Shepard pass zeroed
+// capped at |kappa| <= 1/support; to surface[n + i][S_RAW_CURVATURE] (the Shepard pass zeroed
 // it for everyone else).
 @compute @workgroup_size(64)
 fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -139,7 +139,7 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     let n = P.sizes.n_particles;
     let liquid = P.tension.liquid;
     let s_i = surface[i];
-    if (phase[i] != liquid || s_i.w == 0.0) { return; }
+    if (phase[i] != liquid || s_i[S_DELTA] == 0.0) { return; }
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
@@ -150,9 +150,9 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         let r2 = len2(d);
         if (r2 < P.kernel.support2) {
             let s_j = surface[j];
-            if (phase[j] == liquid && s_j.w != 0.0) {
+            if (phase[j] == liquid && s_j[S_DELTA] != 0.0) {
                 let r = sqrt(r2);
-                let fv = tension_ramp(tension_temperature(j)) * (mass[j] / P.phases[liquid].rho0) * s_j.w;
+                let fv = tension_ramp(tension_temperature(j)) * (mass[j] / P.phases[liquid].rho0) * s_j[S_DELTA];
                 den = den + fv * kernel_w(r);
                 if (r2 > 0.0) {
                     let dn = (s_i.x - s_j.x) * d.x + (s_i.y - s_j.y) * d.y + (s_i.z - s_j.z) * d.z;
@@ -165,7 +165,7 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     if (den > 0.0) {
         kappa = -(num / den);
     }
-    surface[n + i].z = min(max(kappa, -P.tension.kappa_max), P.tension.kappa_max);
+    surface[n + i][S_RAW_CURVATURE] = min(max(kappa, -P.tension.kappa_max), P.tension.kappa_max);
 }
 
 // Free-surface form, second dispatch: the curvature smoothed, R18 (3.30), the
@@ -177,7 +177,7 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let n = P.sizes.n_particles;
     let liquid = P.tension.liquid;
     let s_i = surface[i];
-    if (phase[i] != liquid || s_i.w == 0.0) { return; }
+    if (phase[i] != liquid || s_i[S_DELTA] == 0.0) { return; }
     let heated = (P.sizes.flags & FLAG_HEAT) != 0u;
     let t_i = tension_temperature(i);
     let pi = pos[i];
@@ -195,15 +195,15 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
             let r = sqrt(r2);
             let w = kernel_w(r);
             let v_j = mass[j] / P.phases[ph_j].rho0;
-            if (ph_j == liquid && surface[j].w != 0.0) {
-                let fv = tension_ramp(tension_temperature(j)) * v_j * surface[j].w;
+            if (ph_j == liquid && surface[j][S_DELTA] != 0.0) {
+                let fv = tension_ramp(tension_temperature(j)) * v_j * surface[j][S_DELTA];
                 den = den + fv * w;
-                num = num + fv * surface[n + j].z * w;
+                num = num + fv * surface[n + j][S_RAW_CURVATURE] * w;
             }
             if (heated && has_temperature(ph_j)) {
                 shepard = shepard + v_j * w;
                 if (r2 > 0.0) {
-                    let g = v_j * (heat[j].y - t_i) * kernel_dw(r) / r;
+                    let g = v_j * (heat[j][H_TEMPERATURE] - t_i) * kernel_dw(r) / r;
                     gt.x = gt.x + g * d.x;
                     gt.y = gt.y + g * d.y;
                     gt.z = gt.z + g * d.z;
@@ -218,7 +218,7 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     if (shepard > 0.0) {
         gt = vec3<f32>(gt.x / shepard, gt.y / shepard, gt.z / shepard);
     }
-    surface[n + i].y = kappa;
+    surface[n + i][S_CURVATURE] = kappa;
     var a = acc[i];
     a = vec4<f32>(a.xyz + tension_force(s_i, t_i, kappa, gt, P.phases[liquid].rho0), a.w);
     acc[i] = a;
@@ -234,8 +234,8 @@ fn recoil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let ph = phase[i];
     if ((P.phases[ph].flags & PHASE_RECOIL) == 0u) { return; }
     let s = surface[i];
-    if (s.w == 0.0) { return; }
-    let f = vapour_pressure(ph, heat[i].y) * s.w / P.phases[ph].rho0;
+    if (s[S_DELTA] == 0.0) { return; }
+    let f = vapour_pressure(ph, heat[i][H_TEMPERATURE]) * s[S_DELTA] / P.phases[ph].rho0;
     var a = acc[i];
     a.x = a.x - f * s.x;
     a.y = a.y - f * s.y;

@@ -70,8 +70,8 @@ impl Held {
     /// What a scene holds, from its model (the same as its schedule's features:
     /// `backend::Pipeline::held`, checked in tests/fields.rs).
     pub fn of_model(m: &crate::model::Model) -> Held {
-        let implicit_heat = m.is_thermal()
-            && m.heat.integrator == crate::scene::HeatIntegrator::Trapezoidal;
+        let implicit_heat =
+            m.is_thermal() && m.heat.integrator == crate::scene::HeatIntegrator::Trapezoidal;
         Held {
             heat: m.is_thermal(),
             interface: m.needs_interface(),
@@ -132,8 +132,18 @@ impl FieldDef {
 macro_rules! field {
     ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
      $per:literal, $float:literal, $holder:expr, $frames:expr) => {
-        field!($name, $array, $binding, $scratch, $components, $per, $float, $holder,
-            $frames, Holder::Every)
+        field!(
+            $name,
+            $array,
+            $binding,
+            $scratch,
+            $components,
+            $per,
+            $float,
+            $holder,
+            $frames,
+            Holder::Every
+        )
     };
     ($name:literal, $array:ident, $binding:literal, $scratch:expr, $components:literal,
      $per:literal, $float:literal, $holder:expr, $frames:expr, $sorted:expr) => {
@@ -278,7 +288,10 @@ pub fn wgsl_reorder(k: &str, s: &str, indent: &str) -> String {
     for f in FIELDS.iter() {
         let Some(scratch) = f.scratch else { continue };
         let copy = format!("{scratch}[{k}] = {}[{s}];", f.binding);
-        let guards: Vec<&str> = [f.holder, f.sorted_when].into_iter().filter_map(flag).collect();
+        let guards: Vec<&str> = [f.holder, f.sorted_when]
+            .into_iter()
+            .filter_map(flag)
+            .collect();
         match guards.first() {
             None => out.push_str(&format!("{indent}{copy}\n")),
             Some(g) => out.push_str(&format!(
@@ -335,7 +348,9 @@ mod tests {
     fn table_rows_read_and_write_their_own_array() {
         let mut st = State::default();
         for (k, t) in TABLES.iter().enumerate() {
-            let words: Vec<u32> = (0..t.components as u32).map(|w| 100 * k as u32 + w).collect();
+            let words: Vec<u32> = (0..t.components as u32)
+                .map(|w| 100 * k as u32 + w)
+                .collect();
             (t.set)(&mut st, bytemuck::cast_slice(&words));
             assert_eq!((t.words)(&st), &words[..], "{}", t.name);
             assert_eq!(t.entries(&st), 1, "{}", t.name);

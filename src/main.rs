@@ -580,20 +580,26 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
     // Every limit of the table the scene has (limits::LIMITS); the first four
     // always, saying "none" where the physics is absent.
     use spatter::model::limits::Limit;
-    let always = [Limit::Acoustic, Limit::Viscous, Limit::Force, Limit::Conduction];
+    let always = [
+        Limit::Acoustic,
+        Limit::Viscous,
+        Limit::Force,
+        Limit::Conduction,
+    ];
     let listed: Vec<String> = l
         .rows()
         .iter()
         .filter(|(k, v)| always.contains(k) || v.is_finite())
         .map(|(k, v)| {
-            let name = if *k == Limit::Force { "body force" } else { k.def().name };
+            let name = if *k == Limit::Force {
+                "body force"
+            } else {
+                k.def().name
+            };
             format!("{name} {}", limit(*v))
         })
         .collect();
-    println!(
-        "time-step limits: {}; binding: {which}",
-        listed.join(", ")
-    );
+    println!("time-step limits: {}; binding: {which}", listed.join(", "));
     match m.fixed_dt {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),
         None => println!("time step: adaptive, initially {lim:.4e} s"),

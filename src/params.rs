@@ -538,7 +538,9 @@ impl Params {
             },
             heat_tolerance: m.heat.tolerance as f32,
             heat_max_iterations: m.heat.max_iterations,
-            delta_hc: m.delta.map_or(0.0, |d| (d * m.h * m.max_sound_speed()) as f32),
+            delta_hc: m
+                .delta
+                .map_or(0.0, |d| (d * m.h * m.max_sound_speed()) as f32),
             viscosity_factor: (2.0 * (m.dim as f64 + 2.0)) as f32,
             pad0: 0.0,
             pad1: 0.0,

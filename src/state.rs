@@ -96,6 +96,19 @@ pub struct Solver {
     pub _pad: u32,
 }
 
+/// Slots of the packed per-particle vectors (WGSL twins in lib/params.wgsl):
+/// `heat[i]` is (h, T, f_l, dh/dt).
+pub const H_ENTHALPY: usize = 0;
+pub const H_TEMPERATURE: usize = 1;
+pub const H_LIQUID: usize = 2;
+pub const H_RATE: usize = 3;
+/// `surface[i]` is (outward normal xyz, surface delta δ); `surface[n + i]` is
+/// (Shepard sum Γ, curvature κ, the free-surface form's raw κ, unused).
+pub const S_DELTA: usize = 3;
+pub const S_SHEPARD: usize = 0;
+pub const S_CURVATURE: usize = 1;
+pub const S_RAW_CURVATURE: usize = 2;
+
 /// `State::body` of a particle that belongs to no body.
 pub const NO_BODY: u32 = u32::MAX;
 

@@ -4,7 +4,10 @@
 #[test]
 fn module_graph_has_no_unexplained_cycle() {
     let out = std::process::Command::new("python3")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tools/module_graph.py"))
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tools/module_graph.py"
+        ))
         .output()
         .expect("python3 runs tools/module_graph.py");
     assert!(

@@ -249,7 +249,10 @@ fn implicit_heat_repeat() {
         let st = assert_bit_identical_text(&format!("{name}_implicit"), &text, steps);
         let s = st.solvers[spatter::backend::SolverSlot::Heat as usize];
         assert!(s.iterations >= 2, "{name}: {s:?}");
-        assert!(s.converged == 1 && s.residual <= tolerance as f32, "{name}: {s:?}");
+        assert!(
+            s.converged == 1 && s.residual <= tolerance as f32,
+            "{name}: {s:?}"
+        );
     }
 }
 
@@ -281,7 +284,10 @@ fn delta_sph_with_heat_and_bodies() {
     assert_bit_identical("melt_block_3d", &[DELTA], 100);
     assert_bit_identical("settling_disc_2d", &[DELTA], 100);
     assert_bit_identical_at(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/pbf/line_melt_coarse_2d.toml"),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/pbf/line_melt_coarse_2d.toml"
+        ),
         &[
             "simulation.formulation=\"wcsph\"",
             "phases.plate.temperature=1650.0",

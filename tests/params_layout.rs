@@ -225,13 +225,24 @@ fn flag_and_code_constants_match() {
         ("LASER_SURFACE", rs::LASER_SURFACE),
         ("HEAT_EULER", rs::HEAT_EULER),
         ("HEAT_TRAPEZOIDAL", rs::HEAT_TRAPEZOIDAL),
-        (
-            "SOLVER_HEAT",
-            spatter::backend::SolverSlot::Heat as u32,
-        ),
+        ("SOLVER_HEAT", spatter::backend::SolverSlot::Heat as u32),
     ];
     for (name, v) in expected {
         assert_eq!(value(name), v, "{name}");
+    }
+    use spatter::state as st;
+    let slots = [
+        ("H_ENTHALPY", st::H_ENTHALPY),
+        ("H_TEMPERATURE", st::H_TEMPERATURE),
+        ("H_LIQUID", st::H_LIQUID),
+        ("H_RATE", st::H_RATE),
+        ("S_DELTA", st::S_DELTA),
+        ("S_SHEPARD", st::S_SHEPARD),
+        ("S_CURVATURE", st::S_CURVATURE),
+        ("S_RAW_CURVATURE", st::S_RAW_CURVATURE),
+    ];
+    for (name, v) in slots {
+        assert_eq!(value(name), v as u32, "{name}");
     }
     for d in &spatter::model::limits::LIMITS {
         assert_eq!(value(d.wgsl), d.limit.code(), "{}", d.wgsl);

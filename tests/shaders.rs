@@ -11,7 +11,11 @@ fn every_shader_validates() {
     // Every pass file of the pass table is composed, and every composed file
     // belongs to a stage.
     for d in spatter::backend::STAGES.iter() {
-        assert!(sources.iter().any(|(n, _)| *n == d.file), "no shaders/{}.wgsl", d.file);
+        assert!(
+            sources.iter().any(|(n, _)| *n == d.file),
+            "no shaders/{}.wgsl",
+            d.file
+        );
     }
     for (name, _) in &sources {
         assert!(

@@ -277,6 +277,17 @@ const LASER_SURFACE: u32 = 2u;
 const HEAT_EULER: u32 = 0u;
 const HEAT_TRAPEZOIDAL: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;
+// Slots of the packed per-particle vectors (src/state.rs, same names): heat[i]
+// is (h, T, f_l, dh/dt); surface[i] is (normal xyz, delta) and surface[n + i]
+// (Shepard sum, curvature, raw curvature, -).
+const H_ENTHALPY: u32 = 0u;
+const H_TEMPERATURE: u32 = 1u;
+const H_LIQUID: u32 = 2u;
+const H_RATE: u32 = 3u;
+const S_DELTA: u32 = 3u;
+const S_SHEPARD: u32 = 0u;
+const S_CURVATURE: u32 = 1u;
+const S_RAW_CURVATURE: u32 = 2u;
 // Time-step limit codes (sim.dt_limit; src/model/limits.rs).
 const DT_ACOUSTIC: u32 = 0u;
 const DT_VISCOUS: u32 = 1u;

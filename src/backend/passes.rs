@@ -5,9 +5,9 @@
 
 use super::cpu::CpuBackend;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE,
-    FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT,
-    LASER_SURFACE,
+    Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT,
+    FLAG_INTERFACE, FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL,
+    LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -238,9 +238,13 @@ pub const STAGES: [StageDef; 20] = [
         file: "continuity",
         needed: |f| f.fluid && f.continuity,
         dispatches: &[
-            always("continuity_gradient", Work::Particles, |b| b.continuity_gradient()),
+            always("continuity_gradient", Work::Particles, |b| {
+                b.continuity_gradient()
+            }),
             always("continuity_rate", Work::Particles, |b| b.continuity_rate()),
-            always("continuity_update", Work::Particles, |b| b.continuity_update()),
+            always("continuity_update", Work::Particles, |b| {
+                b.continuity_update()
+            }),
         ],
     },
     StageDef {
@@ -256,7 +260,12 @@ pub const STAGES: [StageDef; 20] = [
         file: "interface",
         needed: |f| f.interface,
         dispatches: &[
-            when("shepard", Work::Particles, |f| !f.gas_interface, |b| b.shepard()),
+            when(
+                "shepard",
+                Work::Particles,
+                |f| !f.gas_interface,
+                |b| b.shepard(),
+            ),
             always("normals", Work::Particles, |b| b.normals()),
             when("wetting", Work::Particles, |f| f.wetting, |b| b.wetting()),
         ],
@@ -307,7 +316,12 @@ pub const STAGES: [StageDef; 20] = [
                 |f| f.laser_surface,
                 |b| b.laser_surface(),
             ),
-            when("laser_bins", Work::LaserBins, |f| f.laser_bins, |b| b.laser_bins()),
+            when(
+                "laser_bins",
+                Work::LaserBins,
+                |f| f.laser_bins,
+                |b| b.laser_bins(),
+            ),
             when(
                 "laser_columns",
                 Work::LaserColumns,
@@ -328,7 +342,9 @@ pub const STAGES: [StageDef; 20] = [
         file: "heat",
         needed: |f| f.heat,
         dispatches: &[
-            always("wall_temperature", Work::Particles, |b| b.wall_temperature()),
+            always("wall_temperature", Work::Particles, |b| {
+                b.wall_temperature()
+            }),
             always("conduct", Work::Particles, |b| b.conduct()),
         ],
     },
@@ -470,8 +486,16 @@ mod tests {
     #[test]
     fn every_stage_has_one_row_and_every_entry_point_one_stage() {
         for (k, d) in STAGES.iter().enumerate() {
-            assert!(!STAGES[k + 1..].iter().any(|o| o.stage == d.stage), "{:?}", d.stage);
-            assert!(!STAGES[k + 1..].iter().any(|o| o.name == d.name), "{}", d.name);
+            assert!(
+                !STAGES[k + 1..].iter().any(|o| o.stage == d.stage),
+                "{:?}",
+                d.stage
+            );
+            assert!(
+                !STAGES[k + 1..].iter().any(|o| o.name == d.name),
+                "{}",
+                d.name
+            );
         }
         let e = entry_points();
         for (k, (entry, _)) in e.iter().enumerate() {

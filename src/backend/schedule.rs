@@ -48,7 +48,9 @@ impl Node {
     pub fn stages(&self) -> Vec<Stage> {
         match self {
             Node::Stage(s) => vec![*s],
-            Node::Repeat(r) => std::iter::once(r.begin).chain(r.stages.iter().copied()).collect(),
+            Node::Repeat(r) => std::iter::once(r.begin)
+                .chain(r.stages.iter().copied())
+                .collect(),
         }
     }
     /// Each stage as often as the GPU records it: a repeat's stages
@@ -261,7 +263,11 @@ impl Pipeline {
                     "{}, repeat <= {} until converged [{}]",
                     r.begin.name(),
                     r.max_iterations,
-                    r.stages.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")
+                    r.stages
+                        .iter()
+                        .map(|s| s.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             })
             .collect::<Vec<_>>()

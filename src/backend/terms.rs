@@ -179,8 +179,13 @@ pub fn reaction_terms() -> impl Iterator<Item = &'static PairTerm> {
 /// Whether `pass`'s WGSL carries term `t`: its own, a reaction term in the
 /// bodies pass, or a term one of those needs.
 fn carried(pass: &str, t: &PairTerm) -> bool {
-    let direct = |u: &PairTerm| u.pass == pass || (pass == REACTION_PASS && reaction_terms().any(|r| r.name == u.name));
-    direct(t) || PAIR_TERMS.iter().any(|u| direct(u) && u.needs.contains(&t.name))
+    let direct = |u: &PairTerm| {
+        u.pass == pass || (pass == REACTION_PASS && reaction_terms().any(|r| r.name == u.name))
+    };
+    direct(t)
+        || PAIR_TERMS
+            .iter()
+            .any(|u| direct(u) && u.needs.contains(&t.name))
 }
 
 /// The pass's term sources, in registry order (appended to the pass's WGSL).
@@ -242,8 +247,12 @@ mod tests {
         let rust = section(include_str!("cpu/bodies.rs"), "pub fn forces(");
         let mut last = (0, 0);
         for t in super::reaction_terms() {
-            let w = wgsl.find(&format!(" {}(", t.name)).unwrap_or_else(|| panic!("bodies.wgsl: {}", t.name));
-            let r = rust.find(&format!("terms::{}(", t.name)).unwrap_or_else(|| panic!("cpu/bodies.rs: {}", t.name));
+            let w = wgsl
+                .find(&format!(" {}(", t.name))
+                .unwrap_or_else(|| panic!("bodies.wgsl: {}", t.name));
+            let r = rust
+                .find(&format!("terms::{}(", t.name))
+                .unwrap_or_else(|| panic!("cpu/bodies.rs: {}", t.name));
             assert!(w > last.0 && r > last.1, "{} out of order", t.name);
             last = (w, r);
         }

@@ -160,7 +160,11 @@ pub struct HeatIntegration {
 /// sweep; the GPU records all of them whether or not they run).
 pub const MAX_HEAT_ITERATIONS: u32 = 64;
 
-fn heat_integration(cx: &Ctx, scene: &SceneFile, thermal: bool) -> Result<HeatIntegration, InputError> {
+fn heat_integration(
+    cx: &Ctx,
+    scene: &SceneFile,
+    thermal: bool,
+) -> Result<HeatIntegration, InputError> {
     let Some(h) = scene.heat else {
         return Ok(HeatIntegration {
             integrator: crate::scene::HeatIntegrator::Euler,
@@ -175,7 +179,10 @@ fn heat_integration(cx: &Ctx, scene: &SceneFile, thermal: bool) -> Result<HeatIn
     if !(1..=MAX_HEAT_ITERATIONS).contains(&h.max_iterations) {
         return Err(cx.err(
             "heat.max_iterations",
-            format!("must be 1 to {MAX_HEAT_ITERATIONS} (got {})", h.max_iterations),
+            format!(
+                "must be 1 to {MAX_HEAT_ITERATIONS} (got {})",
+                h.max_iterations
+            ),
         ));
     }
     Ok(HeatIntegration {

@@ -31,6 +31,7 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use super::terms;
 use crate::kernel;
 use crate::params::{Params, PHASE_FREE_SLIP, SHADER_CONSTS};
+use crate::state::H_TEMPERATURE;
 use crate::state::{Body, State, BODY_SOLIDIFIED, NO_BODY};
 use rayon::prelude::*;
 
@@ -244,7 +245,8 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                 if sf {
                     // F22 (33) as the forces pass applies it between the melt
                     // and a wall: the fluid's own α^sf, mass and sound speed.
-                    let alpha_j = terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][1]);
+                    let alpha_j =
+                        terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][H_TEMPERATURE]);
                     let alpha = (alpha_j + alpha_j) * 0.5;
                     let u = [v_j[0] - v_r[0], v_j[1] - v_r[1], v_j[2] - v_r[2]];
                     let s = terms::solid_fluid_viscosity(

@@ -32,11 +32,11 @@
 //! (3.55) is the same kick–drift–kick split for the velocity; keeping F22's lets
 //! every other pass (bodies, heat, the transport velocity) stay as it is.
 
+use super::bodies::point_velocity;
+use super::density::equation_of_state;
 use super::neighbors::{
     for_each_neighbor, min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
-use super::bodies::point_velocity;
-use super::density::equation_of_state;
 use crate::kernel;
 use crate::params::{Params, FLAG_BODIES};
 use crate::state::{State, NO_BODY};
@@ -158,12 +158,15 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
             if r2 > 0.0 {
                 let v_j = st.vel[j];
                 let f = kernel::dw(pr, r) / r;
-                let ud = (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
+                let ud =
+                    (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
                 div += vol_j * ud * f;
                 if ph_j == ph_i {
                     let dr = rho_j - mat_i.rho0 - excess_i;
                     let g_j = st.density_gradient[j];
-                    let gd = (g_i[0] + g_j[0]) * d[0] + (g_i[1] + g_j[1]) * d[1] + (g_i[2] + g_j[2]) * d[2];
+                    let gd = (g_i[0] + g_j[0]) * d[0]
+                        + (g_i[1] + g_j[1]) * d[1]
+                        + (g_i[2] + g_j[2]) * d[2];
                     diff -= vol_j * (dr + dr + gd) * f;
                 }
             }

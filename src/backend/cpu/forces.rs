@@ -19,6 +19,7 @@ use crate::kernel;
 use crate::model::MAX_PHASES;
 use crate::params::{Params, KIND_WALL, PHASE_FREE_SLIP};
 use crate::state::State;
+use crate::state::{H_TEMPERATURE, S_DELTA};
 use rayon::prelude::*;
 
 /// Calls `f::<…>(args)` with one const bool per runtime switch, in order: one
@@ -97,13 +98,13 @@ fn sweep<
             let mut fb = [0.0f32; 3];
             let mut heating = 0.0f32;
             let alpha_i = if IV {
-                terms::interface_viscosity_alpha(pr, surface[i][3])
+                terms::interface_viscosity_alpha(pr, surface[i][S_DELTA])
             } else {
                 0.0
             };
             let gamma_i = if DF { cont[i][1] } else { 1.0 };
             let alpha_sf_i = if SF {
-                terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][1])
+                terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][H_TEMPERATURE])
             } else {
                 0.0
             };
@@ -169,7 +170,7 @@ fn sweep<
                 }
                 if IV && !wall {
                     let alpha =
-                        (alpha_i + terms::interface_viscosity_alpha(pr, surface[j][3])) * 0.5;
+                        (alpha_i + terms::interface_viscosity_alpha(pr, surface[j][S_DELTA])) * 0.5;
                     let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
                     let s = terms::interface_viscosity(
                         pr, m_i, m_j, rho_i, rho_j, mat_i.c2, mat_j.c2, u, d, r2, dwdr, alpha,
@@ -182,7 +183,7 @@ fn sweep<
                     let alpha_j = if wall {
                         alpha_sf_i
                     } else {
-                        terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][1])
+                        terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][H_TEMPERATURE])
                     };
                     let alpha = (alpha_sf_i + alpha_j) * 0.5;
                     let c2_j = if wall { mat_i.c2 } else { mat_j.c2 };

@@ -24,13 +24,14 @@
 //!   the solid ↔ liquid switch at f_l = ½.
 
 use super::neighbors::{for_each_neighbor, CellTable};
+use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
-use crate::backend::SolverSlot;
 use crate::state::{Solver, State, BODY_SOLIDIFIED};
+use crate::state::{H_ENTHALPY, H_LIQUID, H_RATE, H_TEMPERATURE, S_DELTA};
 use rayon::prelude::*;
 
 /// Density a particle's volume and heat capacity use: summation density for
@@ -60,9 +61,9 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
                 }
                 let wk = kernel::w(pr, r2.sqrt());
                 sw += wk;
-                st_ += heat_in[j][1] * wk;
+                st_ += heat_in[j][H_TEMPERATURE] * wk;
             });
-            let t_wall = heat_in[i][0];
+            let t_wall = heat_in[i][H_ENTHALPY];
             Some(if sw > 0.0 {
                 2.0 * t_wall - st_ / sw
             } else {
@@ -72,7 +73,7 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
         .collect();
     for (hv, t) in st.heat.iter_mut().zip(out) {
         if let Some(t) = t {
-            hv[1] = t;
+            hv[H_TEMPERATURE] = t;
         }
     }
 }
@@ -85,8 +86,8 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
     let (pos, rho, mass, phase, heat) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let eta2 = pr.kernel.eta2;
     let ph_i = phase[i];
-    let k_i = conductivity(pr, ph_i, heat[i][2]);
-    let t_i = heat[i][1];
+    let k_i = conductivity(pr, ph_i, heat[i][H_LIQUID]);
+    let t_i = heat[i][H_TEMPERATURE];
     let mut sum = 0.0f32;
     for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
         if r2 <= 0.0 {
@@ -94,7 +95,7 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
         }
         let ph_j = phase[j];
         let k_ij = if pr.conducts(ph_j) {
-            let k_j = conductivity(pr, ph_j, heat[j][2]);
+            let k_j = conductivity(pr, ph_j, heat[j][H_LIQUID]);
             // Ordered operands: i and j compute the same bits, so the
             // pair's fluxes cancel exactly in the total enthalpy.
             4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
@@ -106,14 +107,14 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
         let r = r2.sqrt();
         let f = kernel::dw(pr, r) * r / (r2 + eta2);
         let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
-        sum += v_j * k_ij * (t_i - heat[j][1]) * f;
+        sum += v_j * k_ij * (t_i - heat[j][H_TEMPERATURE]) * f;
     });
     let mut source = laser_source;
     if pr.flag(crate::params::FLAG_VISCOUS_HEATING) {
         source += st.acc[i][3];
     }
     let loss = if pr.flag(FLAG_INTERFACE) {
-        surface_loss(pr, ph_i, t_i, st.surface[i][3])
+        surface_loss(pr, ph_i, t_i, st.surface[i][S_DELTA])
     } else {
         0.0
     };
@@ -132,7 +133,13 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
             if !pr.conducts(s.phase[i]) {
                 return 0.0;
             }
-            rate(pr, s, grid, i, if laser_on { s.heat[i][3] } else { 0.0 })
+            rate(
+                pr,
+                s,
+                grid,
+                i,
+                if laser_on { s.heat[i][H_RATE] } else { 0.0 },
+            )
         })
         .collect();
     let phase = &st.phase;
@@ -142,8 +149,8 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
         .enumerate()
         .for_each(|(i, (hv, rate))| {
             if pr.conducts(phase[i]) {
-                hv[0] += dt * rate;
-                hv[3] = rate;
+                hv[H_ENTHALPY] += dt * rate;
+                hv[H_RATE] = rate;
             }
         });
 }
@@ -174,8 +181,13 @@ pub fn begin(pr: &Params, st: &mut State) {
         .enumerate()
         .for_each(|(i, (hs, hv))| {
             *hs = if pr.conducts(phase[i]) {
-                let h = [hv[0], if laser_on { hv[3] } else { 0.0 }, 0.0, 0.0];
-                hv[3] = 0.0;
+                let h = [
+                    hv[H_ENTHALPY],
+                    if laser_on { hv[H_RATE] } else { 0.0 },
+                    0.0,
+                    0.0,
+                ];
+                hv[H_RATE] = 0.0;
                 h
             } else {
                 [0.0; 4]
@@ -196,16 +208,13 @@ pub fn iterate_temperature(pr: &Params, st: &mut State) {
     }
     let n = st.active();
     let phase = &st.phase;
-    st.heat[..n]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(i, hv)| {
-            if pr.conducts(phase[i]) {
-                let (t, fl) = temperature_of(pr, phase[i], hv[0]);
-                hv[1] = t;
-                hv[2] = fl;
-            }
-        });
+    st.heat[..n].par_iter_mut().enumerate().for_each(|(i, hv)| {
+        if pr.conducts(phase[i]) {
+            let (t, fl) = temperature_of(pr, phase[i], hv[H_ENTHALPY]);
+            hv[H_TEMPERATURE] = t;
+            hv[H_LIQUID] = fl;
+        }
+    });
 }
 
 /// `iterate_conduct`: ḣ_k (kept as ḣ_0 in heat_start.z on the first
@@ -238,9 +247,9 @@ pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 if first {
                     hs[2] = rate;
                 }
-                hs[3] = (rate - hv[3]).abs();
-                hv[0] = hs[0] + dt * ((hs[2] + rate) * 0.5);
-                hv[3] = rate;
+                hs[3] = (rate - hv[H_RATE]).abs();
+                hv[H_ENTHALPY] = hs[0] + dt * ((hs[2] + rate) * 0.5);
+                hv[H_RATE] = rate;
             }
         });
 }
@@ -255,7 +264,12 @@ pub fn residual(pr: &Params, st: &mut State) {
     let (dmax, smax) = (0..st.active())
         .into_par_iter()
         .filter(|&i| pr.conducts(st.phase[i]))
-        .map(|i| (st.heat_start[i][3], (st.heat_start[i][2] + st.heat[i][3]).abs()))
+        .map(|i| {
+            (
+                st.heat_start[i][3],
+                (st.heat_start[i][2] + st.heat[i][H_RATE]).abs(),
+            )
+        })
         .reduce(|| (0.0f32, 0.0f32), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     let s = &mut st.solvers[SolverSlot::Heat as usize];
     s.residual = if smax == 0.0 {
@@ -363,9 +377,9 @@ pub fn temperature(pr: &Params, st: &mut State) {
             if !pr.conducts(*ph) {
                 return None;
             }
-            let (t, fl) = temperature_of(pr, *ph, hv[0]);
-            hv[1] = t;
-            hv[2] = fl;
+            let (t, fl) = temperature_of(pr, *ph, hv[H_ENTHALPY]);
+            hv[H_TEMPERATURE] = t;
+            hv[H_LIQUID] = fl;
             let target = pr.switch_target(*ph)?;
             let solid = pr.phases[*ph as usize].kind == KIND_SOLID;
             if solid && fl >= 0.5 {

@@ -8,6 +8,7 @@
 
 use crate::params::Params;
 use crate::state::State;
+use crate::state::H_LIQUID;
 use rayon::prelude::*;
 
 pub fn kick_drift(pr: &Params, st: &mut State) {
@@ -83,7 +84,7 @@ pub fn kick(pr: &Params, st: &mut State) {
         }
         let sink = pr.phases[phase[i] as usize].mushy_damping;
         if sink > 0.0 {
-            let damp = 1.0 + dt * sink * (1.0 - heat[i][2]);
+            let damp = 1.0 + dt * sink * (1.0 - heat[i][H_LIQUID]);
             for c in v.iter_mut().take(3) {
                 *c /= damp;
             }
@@ -94,6 +95,7 @@ pub fn kick(pr: &Params, st: &mut State) {
 #[cfg(test)]
 mod tests {
     use crate::params::Params;
+    use crate::state::H_LIQUID;
 
     /// A moving wall particle drifts by Δt u_wall whatever its acceleration, and
     /// wraps on a periodic axis; a standing wall particle keeps its place.
@@ -144,7 +146,7 @@ mod tests {
             st.phase[k] = melt;
             st.vel[k] = [1.0, -2.0, 0.5, 0.0];
             st.acc[k] = [0.0; 4];
-            st.heat[k][2] = fl;
+            st.heat[k][H_LIQUID] = fl;
         }
         super::kick(&pr, &mut st);
         let damp = 1.0 + 5.0e-7f32 * 1.0e6 * 0.5;

@@ -25,6 +25,7 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
 use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
+use crate::state::{H_TEMPERATURE, S_DELTA, S_SHEPARD};
 use rayon::prelude::*;
 
 #[inline(always)]
@@ -68,7 +69,7 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
     let (pos, mass, phase, surface) = (&st.pos, &st.mass, &st.phase, &st.surface);
     let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
-    let gamma = |j: usize| surface[n + j][0];
+    let gamma = |j: usize| surface[n + j][S_SHEPARD];
     let inv_h = pr.kernel.inv_h;
     let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
@@ -109,7 +110,7 @@ pub fn wetting(pr: &Params, st: &mut State, grid: &CellTable) {
         .map(|i| {
             let ph = s.phase[i];
             let n_i = s.surface[i];
-            if n_i[3] == 0.0 || (ph != pr.tension.liquid && ph != pr.tension.gas) {
+            if n_i[S_DELTA] == 0.0 || (ph != pr.tension.liquid && ph != pr.tension.gas) {
                 return n_i;
             }
             wet(pr, s, grid, i, n_i)
@@ -139,7 +140,7 @@ fn solid_weight(pr: &Params, st: &State, j: usize) -> f32 {
     if t.inv_ramp_width == 0.0 || !pr.conducts(st.phase[j]) {
         return 1.0;
     }
-    1.0 - ((st.heat[j][1] - t.t_melt) * t.inv_ramp_width + 1.0)
+    1.0 - ((st.heat[j][H_TEMPERATURE] - t.t_melt) * t.inv_ramp_width + 1.0)
         .max(0.0)
         .min(1.0)
 }

@@ -23,6 +23,7 @@ use super::neighbors::{for_each_near, min_image, CellTable};
 use crate::params::{Params, KIND_GAS};
 use crate::portable_math::exp as pm_exp;
 use crate::state::State;
+use crate::state::{H_RATE, S_DELTA};
 use rayon::prelude::*;
 
 /// Liquid and solid particles absorb; gas is transparent, walls take no heat.
@@ -134,7 +135,7 @@ fn write_source(pr: &Params, st: &mut State, q: &[f32]) {
     let phase = &st.phase;
     for (i, hv) in st.heat[..q.len()].iter_mut().enumerate() {
         if pr.conducts(phase[i]) {
-            hv[3] = q[i];
+            hv[H_RATE] = q[i];
         }
     }
 }
@@ -252,7 +253,7 @@ pub fn surface(pr: &Params, st: &mut State) {
                 return 0.0;
             }
             let cos = surf[i][up].max(0.0);
-            irradiance(pr, &pos[i], centre, power) * cos * surf[i][3]
+            irradiance(pr, &pos[i], centre, power) * cos * surf[i][S_DELTA]
                 / pr.phases[phase[i] as usize].rho0
         })
         .collect();

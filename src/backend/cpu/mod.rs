@@ -197,7 +197,12 @@ impl Backend for CpuBackend {
     fn run_stage(&mut self, stage: Stage) {
         let t0 = Instant::now();
         let features = self.pipeline.features;
-        for d in stage.def().dispatches.iter().filter(|d| (d.when)(&features)) {
+        for d in stage
+            .def()
+            .dispatches
+            .iter()
+            .filter(|d| (d.when)(&features))
+        {
             if let Twin::Run(twin) = d.cpu {
                 twin(self);
             }

@@ -445,10 +445,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     // Every sorted field the scene holds (crate::fields); the others are
     // recomputed after the sort.
     let held = Held::of_state(st);
-    for f in FIELDS
-        .iter()
-        .filter(|f| f.sorted_in(held))
-    {
+    for f in FIELDS.iter().filter(|f| f.sorted_in(held)) {
         (f.permute)(st, &perm);
     }
     let n_cells = pr.sizes.n_cells as usize;

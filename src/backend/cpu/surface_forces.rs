@@ -28,6 +28,7 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
 use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
 use crate::state::State;
+use crate::state::{H_TEMPERATURE, S_CURVATURE, S_DELTA, S_RAW_CURVATURE};
 use rayon::prelude::*;
 
 /// F22 (21) f[T, T_m, T_m + ΔT_s]; 1 without a ramp. max then min, as the WGSL
@@ -46,7 +47,7 @@ fn ramp(pr: &Params, t: f32) -> f32 {
 #[inline(always)]
 fn temperature(pr: &Params, st: &State, j: usize) -> f32 {
     if pr.flag(FLAG_HEAT) {
-        st.heat[j][1]
+        st.heat[j][H_TEMPERATURE]
     } else {
         0.0
     }
@@ -86,7 +87,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
                 return None;
             }
             let n_i = s.surface[i];
-            if n_i[3] == 0.0 {
+            if n_i[S_DELTA] == 0.0 {
                 return Some((None, 0.0));
             }
             let liquid_i = ph_i == pr.tension.liquid;
@@ -115,7 +116,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
                     }
                 }
                 if heated && r2 > 0.0 && has_temperature(ph_j) {
-                    let g = volume(j) * (s.heat[j][1] - t_i) * kernel::dw(pr, r) / r;
+                    let g = volume(j) * (s.heat[j][H_TEMPERATURE] - t_i) * kernel::dw(pr, r) / r;
                     for a in 0..3 {
                         gt[a] += g * d[a];
                     }
@@ -135,7 +136,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
                 st.acc[i][c] += a[c];
             }
         }
-        st.surface[n + i][1] = kappa;
+        st.surface[n + i][S_CURVATURE] = kappa;
     }
 }
 
@@ -158,14 +159,16 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
     let s: &State = st;
     let liquid = pr.tension.liquid;
     let weight = |j: usize| {
-        ramp(pr, temperature(pr, s, j)) * (s.mass[j] / pr.phase(liquid).rho0) * s.surface[j][3]
+        ramp(pr, temperature(pr, s, j))
+            * (s.mass[j] / pr.phase(liquid).rho0)
+            * s.surface[j][S_DELTA]
     };
     let kmax = pr.tension.kappa_max;
     let kappa: Vec<f32> = (0..active)
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
-            if s.phase[i] != liquid || n_i[3] == 0.0 {
+            if s.phase[i] != liquid || n_i[S_DELTA] == 0.0 {
                 return 0.0;
             }
             let (mut num, mut den) = (0.0f32, 0.0f32);
@@ -189,7 +192,7 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
         })
         .collect();
     for (i, k) in kappa.into_iter().enumerate() {
-        st.surface[n + i][2] = k;
+        st.surface[n + i][S_RAW_CURVATURE] = k;
     }
 }
 
@@ -213,7 +216,7 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
-            if s.phase[i] != liquid || n_i[3] == 0.0 {
+            if s.phase[i] != liquid || n_i[S_DELTA] == 0.0 {
                 return None;
             }
             let t_i = temperature(i);
@@ -223,15 +226,16 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
                 let ph_j = s.phase[j];
                 let r = r2.sqrt();
                 let w = kernel::w(pr, r);
-                if ph_j == liquid && s.surface[j][3] != 0.0 {
-                    let fv = ramp(pr, temperature(j)) * volume(j) * s.surface[j][3];
+                if ph_j == liquid && s.surface[j][S_DELTA] != 0.0 {
+                    let fv = ramp(pr, temperature(j)) * volume(j) * s.surface[j][S_DELTA];
                     den += fv * w;
-                    num += fv * s.surface[n + j][2] * w;
+                    num += fv * s.surface[n + j][S_RAW_CURVATURE] * w;
                 }
                 if heated && has_temperature(ph_j) {
                     shepard += volume(j) * w;
                     if r2 > 0.0 {
-                        let g = volume(j) * (s.heat[j][1] - t_i) * kernel::dw(pr, r) / r;
+                        let g =
+                            volume(j) * (s.heat[j][H_TEMPERATURE] - t_i) * kernel::dw(pr, r) / r;
                         for a in 0..3 {
                             gt[a] += g * d[a];
                         }
@@ -250,7 +254,7 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
         for c in 0..3 {
             st.acc[i][c] += a[c];
         }
-        st.surface[n + i][1] = kappa;
+        st.surface[n + i][S_CURVATURE] = kappa;
     }
 }
 
@@ -272,7 +276,7 @@ fn force(pr: &Params, n_i: [f32; 4], t_i: f32, kappa: f32, gt: [f32; 3], rho: f3
         gt[1] - nt * n_i[1],
         gt[2] - nt * n_i[2],
     ];
-    let scale = ramp(pr, t_i) * n_i[3] / rho;
+    let scale = ramp(pr, t_i) * n_i[S_DELTA] / rho;
     let normal = alpha * kappa;
     [
         scale * (slope * tan[0] - normal * n_i[0]),
@@ -306,7 +310,8 @@ pub fn recoil(pr: &Params, st: &mut State) {
         if s[3] == 0.0 {
             return;
         }
-        let f = super::heat::vapour_pressure(pr, ph, heat[i][1]) * s[3] / pr.phase(ph).rho0;
+        let f =
+            super::heat::vapour_pressure(pr, ph, heat[i][H_TEMPERATURE]) * s[3] / pr.phase(ph).rho0;
         for c in 0..3 {
             a[c] -= f * s[c];
         }

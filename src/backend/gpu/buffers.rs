@@ -26,21 +26,45 @@ pub struct DeviceBuffer {
 /// The device-only buffers, in binding order after the fields and tables.
 pub const DEVICE_BUFFERS: [DeviceBuffer; 8] = [
     // Neighbour search: sort keys (cell, index), the cell table.
-    DeviceBuffer { name: "keys", wgsl: "array<vec2<u32>>" },
-    DeviceBuffer { name: "cell_start", wgsl: "array<u32>" },
-    DeviceBuffer { name: "cell_end", wgsl: "array<u32>" },
+    DeviceBuffer {
+        name: "keys",
+        wgsl: "array<vec2<u32>>",
+    },
+    DeviceBuffer {
+        name: "cell_start",
+        wgsl: "array<u32>",
+    },
+    DeviceBuffer {
+        name: "cell_end",
+        wgsl: "array<u32>",
+    },
     // 1 where a cell holds a fluid particle (set in cell_bounds; the wall pass
     // skips wall particles with no such cell around them). Order-free integer
     // atomics.
-    DeviceBuffer { name: "cell_fluid", wgsl: "array<atomic<u32>>" },
+    DeviceBuffer {
+        name: "cell_fluid",
+        wgsl: "array<atomic<u32>>",
+    },
     // Per-step scalars (Δt, time, step, the binding limit, ...).
-    DeviceBuffer { name: "sim", wgsl: "Sim" },
+    DeviceBuffer {
+        name: "sim",
+        wgsl: "Sim",
+    },
     // A reduction's per-workgroup partial maxima.
-    DeviceBuffer { name: "partials", wgsl: "array<vec2<f32>>" },
+    DeviceBuffer {
+        name: "partials",
+        wgsl: "array<vec2<f32>>",
+    },
     // Laser scenes: per bin (Σ w V, absorbed power).
-    DeviceBuffer { name: "bins", wgsl: "array<vec2<f32>>" },
+    DeviceBuffer {
+        name: "bins",
+        wgsl: "array<vec2<f32>>",
+    },
     // Rigid bodies: each particle id's current index (body_slots).
-    DeviceBuffer { name: "slots", wgsl: "array<u32>" },
+    DeviceBuffer {
+        name: "slots",
+        wgsl: "array<u32>",
+    },
 ];
 
 /// One bindable buffer: its name and WGSL declaration type.
@@ -107,7 +131,9 @@ pub fn pass_bindings(reads: &[&str], writes: &[&str]) -> Result<Vec<PassBinding>
     let all = bindable();
     for n in reads.iter().chain(writes) {
         if !all.iter().any(|b| b.name == *n) {
-            return Err(format!("no buffer named '{n}' (fields, tables, DEVICE_BUFFERS)"));
+            return Err(format!(
+                "no buffer named '{n}' (fields, tables, DEVICE_BUFFERS)"
+            ));
         }
     }
     Ok(all
@@ -226,7 +252,11 @@ impl Buffers {
             tables: TABLES
                 .iter()
                 .map(|t| {
-                    let entries = if held.holds(t.holder) { t.entries(st) } else { 0 };
+                    let entries = if held.holds(t.holder) {
+                        t.entries(st)
+                    } else {
+                        0
+                    };
                     let bytes = entries.max(t.min_entries) as u64 * t.components as u64 * 4;
                     storage(device, t.name, bytes)
                 })
@@ -290,7 +320,11 @@ impl Buffers {
 
 /// A pass's layout of group 0: the parameter block, then its own bindings,
 /// read-only where the pass only reads them.
-pub fn pass_layout(device: &wgpu::Device, pass: &str, bindings: &[PassBinding]) -> wgpu::BindGroupLayout {
+pub fn pass_layout(
+    device: &wgpu::Device,
+    pass: &str,
+    bindings: &[PassBinding],
+) -> wgpu::BindGroupLayout {
     let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,

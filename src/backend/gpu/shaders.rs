@@ -381,7 +381,11 @@ mod tests {
 
     #[test]
     fn a_pass_declares_only_the_buffers_its_header_names() {
-        let src = compose("x", "// uses: params\n// reads: pos cell_fluid\n// writes: acc\nfn f() {}\n").unwrap();
+        let src = compose(
+            "x",
+            "// uses: params\n// reads: pos cell_fluid\n// writes: acc\nfn f() {}\n",
+        )
+        .unwrap();
         assert!(src.contains("var<storage, read_write> acc: array<vec4<f32>>;"));
         assert!(src.contains("var<storage, read> pos: array<vec4<f32>>;"));
         // Atomics stay read_write.

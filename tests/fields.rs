@@ -147,3 +147,28 @@ fn the_models_holders_are_the_schedules() {
         );
     }
 }
+
+/// A scene runs only its formulation's passes and holds only their fields:
+/// summation density and no continuity state on WCSPH; the continuity pass,
+/// its fields and the sorted density on δ-SPH (and no summation-density pass).
+#[test]
+fn a_formulation_runs_and_holds_only_its_own() {
+    use spatter::backend::{Pipeline, Stage};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/validation/dam_break_2d.toml");
+    for (sets, delta) in [
+        (vec![], false),
+        (vec!["simulation.formulation=\"delta_wcsph\"".to_string()], true),
+    ] {
+        let l = spatter::run::load(path, &sets).unwrap();
+        let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
+        let p = Pipeline::for_scene(&params, &l.state);
+        let stages = p.step_stages();
+        assert_eq!(stages.contains(&Stage::Continuity), delta, "{sets:?}");
+        assert_eq!(stages.contains(&Stage::Density), !delta, "{sets:?}");
+        assert_eq!(p.held().continuity, delta);
+        assert_eq!(!l.state.continuity.is_empty(), delta);
+        assert_eq!(!l.state.density_gradient.is_empty(), delta);
+        let rho = FIELDS.iter().find(|f| f.binding == "rho").unwrap();
+        assert_eq!(rho.sorted_in(p.held()), delta, "the density is state only on δ-SPH");
+    }
+}

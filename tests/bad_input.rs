@@ -58,3 +58,34 @@ fn missing_file_exits_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).1.contains("/nonexistent/scene.toml"));
 }
+
+/// The formulation and heat-integration keys of issues 27–28: each wrong
+/// combination exits 2 naming its key; δ-SPH with a pressure floor validates
+/// with a warning naming `simulation.pressure_floor`.
+#[test]
+fn formulation_and_heat_integration_keys() {
+    let dam = common::scene("dam_break_2d");
+    let heat = common::scene("conduction_1d");
+    let delta = "simulation.formulation=\"delta_wcsph\"";
+    let cases: [(&str, &[&str], &str); 5] = [
+        (&dam, &["simulation.delta=0.1"], "simulation.delta"),
+        (&dam, &[delta, "simulation.delta=1.5"], "simulation.delta"),
+        (&dam, &["simulation.viscosity_form=\"marrone\""], "simulation.viscosity_form"),
+        (&dam, &["heat.integrator=\"trapezoidal\""], "key `heat`"),
+        (&heat, &["heat.max_iterations=0"], "heat.max_iterations"),
+    ];
+    for (scene, sets, key) in cases {
+        let mut args = vec!["validate", scene];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        common::assert_input_error(&args, key);
+    }
+    let out = spatter(&["validate", &common::scene("laplace_free_disc_2d"), "--set", "simulation.pressure_floor=true"]);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    assert!(
+        format!("{stdout}{stderr}").contains("key `simulation.pressure_floor`"),
+        "{stdout}{stderr}"
+    );
+}

@@ -290,6 +290,7 @@ fn delta_sph_with_heat_and_bodies() {
         ),
         &[
             "simulation.formulation=\"wcsph\"",
+            "simulation.pressure_floor=true",
             "phases.plate.temperature=1650.0",
             "laser.power=[[0.0, 4.0e6]]",
         ],

@@ -334,11 +334,11 @@ fn particles_without_a_temperature_write_the_ambient_temperature() {
 /// coarse 2D line melt with surface tension, Marangoni and recoil runs to its end
 /// (no watchdog stop), writes an MCAP whose /track `tools/spatter_read.py track`
 /// plots, and prints the melt pool and the track. F22 §4.5 reports only shapes:
-/// the hottest melt passes T_v = 3000 K (measured 3554 K), the remelt depth is
-/// largest where the scan starts (measured 23.7 against 9.2 µm, means of the
+/// the hottest melt passes T_v = 3000 K (measured 3404 K), the remelt depth is
+/// largest where the scan starts (measured 16.1 against 13.3 µm, means of the
 /// first and last tenth of the track; 19.9 against 10.9 on summation density),
-/// and the resolidified surface ends below the initial one (measured −9.0 µm on
-/// average: the 2D slice also loses the 35 particles that splash out).
+/// and the resolidified surface ends below the initial one (measured −5.7 µm on
+/// average: the 2D slice also loses the 3 particles that splash out).
 #[test]
 fn coarse_line_melt_main_job() {
     let dir = common::scratch("coarse_line_melt");

@@ -51,7 +51,8 @@ SCENES = [
     # acting from the first step.
     ("sessile_drop_2d", "sessile_drop_2d", []),
     # The scene runs δ-SPH since issue 28; its reference is summation density's.
-    ("laplace_free_disc_2d", "laplace_free_disc_2d", ['simulation.formulation="wcsph"']),
+    ("laplace_free_disc_2d", "laplace_free_disc_2d",
+     ['simulation.formulation="wcsph"', "simulation.pressure_floor=true"]),
     ("settling_disc_2d", "settling_disc_2d", []),
     ("melting_grain_2d", "melting_grain_2d", []),
     ("free_rotation_3d", "free_rotation_3d", []),

@@ -122,7 +122,7 @@ pub const SWEEPS: &[Sweep] = &[
     Sweep {
         name: "laplace_free_disc_2d@wcsph",
         text: scene_text!("laplace_free_disc_2d"),
-        sets: &["simulation.formulation=\"wcsph\""],
+        sets: &["simulation.formulation=\"wcsph\"", "simulation.pressure_floor=true"],
         length: 0.02,
         cells: &[10, 20, 40],
         expected_order: Some(1.0),

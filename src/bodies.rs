@@ -10,175 +10,143 @@
 
 use crate::model::Model;
 use crate::state::{Body, State, NO_BODY};
+use glam::{DMat3, DQuat, DVec3, DVec4};
 
 /// Mass, centre of mass and inertia tensor about it (f64) of a set of particles.
 pub struct MassProperties {
     pub mass: f64,
-    pub center: [f64; 3],
-    pub inertia: [[f64; 3]; 3],
+    pub center: DVec3,
+    pub inertia: DMat3,
 }
 
 /// F22 (35)–(36) over particles at `x` (grid-relative) with masses `m`.
 /// `particle_inertia`: I_r per unit mass about any axis through the particle (3D
 /// sphere of volume Δx³: 0.4 (∛(3/4π) Δx)²); in 2D only I_zz matters (disc of
 /// area Δx²: ½ Δx²/π).
-pub fn mass_properties(x: &[[f64; 3]], m: &[f64], particle_inertia: f64) -> MassProperties {
+pub fn mass_properties(x: &[DVec3], m: &[f64], particle_inertia: f64) -> MassProperties {
     let mass: f64 = m.iter().sum();
-    let mut c = [0.0; 3];
+    let mut center = DVec3::ZERO;
     for (xi, mi) in x.iter().zip(m) {
-        for a in 0..3 {
-            c[a] += mi * xi[a] / mass;
-        }
+        center += *mi * *xi / mass;
     }
-    let mut inertia = [[0.0; 3]; 3];
+    let mut inertia = DMat3::ZERO;
     for (xi, mi) in x.iter().zip(m) {
-        let r = [xi[0] - c[0], xi[1] - c[1], xi[2] - c[2]];
-        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        for a in 0..3 {
-            for b in 0..3 {
-                let delta = if a == b { 1.0 } else { 0.0 };
-                inertia[a][b] += mi * (particle_inertia * delta + r2 * delta - r[a] * r[b]);
-            }
-        }
+        let r = *xi - center;
+        // m (I_r 1 + |r|² 1 − r rᵀ)
+        let rrt = DMat3::from_cols(r * r.x, r * r.y, r * r.z);
+        inertia += (DMat3::from_diagonal(DVec3::splat(particle_inertia + r.dot(r))) - rrt) * *mi;
     }
     MassProperties {
         mass,
-        center: c,
+        center,
         inertia,
     }
+}
+
+/// Entry (row i, column j) of a matrix.
+fn at(a: &DMat3, i: usize, j: usize) -> f64 {
+    a.col(j)[i]
+}
+
+fn set(a: &mut DMat3, i: usize, j: usize, v: f64) {
+    a.col_mut(j)[i] = v;
+}
+
+fn diagonal(a: &DMat3) -> DVec3 {
+    DVec3::new(a.x_axis.x, a.y_axis.y, a.z_axis.z)
 }
 
 /// Eigen-decomposition of a symmetric 3×3 matrix by cyclic Jacobi rotations:
 /// (eigenvalues, Q) with the eigenvectors as Q's columns, Q a rotation (det +1).
 /// A pair whose off-diagonal entry is exactly 0 is never rotated, so a planar
 /// body's z axis stays a principal axis exactly.
-pub fn principal_axes(a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+pub fn principal_axes(a: DMat3) -> (DVec3, DMat3) {
     let mut a = a;
-    let mut q = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    let scale = (0..3)
-        .map(|k| a[k][k].abs())
-        .fold(0.0, f64::max)
-        .max(f64::MIN_POSITIVE);
+    let mut q = DMat3::IDENTITY;
+    let scale = diagonal(&a).abs().max_element().max(f64::MIN_POSITIVE);
     for _sweep in 0..50 {
-        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        let off = at(&a, 0, 1).abs() + at(&a, 0, 2).abs() + at(&a, 1, 2).abs();
         if off <= 1e-15 * scale {
             break;
         }
         for (p, r) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][r] == 0.0 {
+            let apr = at(&a, p, r);
+            if apr == 0.0 {
                 continue;
             }
             // The rotation in the (p, r) plane that zeroes a[p][r].
-            let theta = 0.5 * (2.0 * a[p][r]).atan2(a[r][r] - a[p][p]);
+            let theta = 0.5 * (2.0 * apr).atan2(at(&a, r, r) - at(&a, p, p));
             let (s, c) = theta.sin_cos();
-            let mut g = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-            g[p][p] = c;
-            g[r][r] = c;
-            g[p][r] = s;
-            g[r][p] = -s;
-            a = mul(&transpose(&g), &mul(&a, &g));
-            a[p][r] = 0.0;
-            a[r][p] = 0.0;
-            q = mul(&q, &g);
+            let mut g = DMat3::IDENTITY;
+            set(&mut g, p, p, c);
+            set(&mut g, r, r, c);
+            set(&mut g, p, r, s);
+            set(&mut g, r, p, -s);
+            a = g.transpose() * (a * g);
+            set(&mut a, p, r, 0.0);
+            set(&mut a, r, p, 0.0);
+            q *= g;
         }
     }
-    if det(&q) < 0.0 {
-        for row in q.iter_mut() {
-            row[2] = -row[2];
-        }
+    if q.determinant() < 0.0 {
+        q.z_axis = -q.z_axis;
     }
-    ([a[0][0], a[1][1], a[2][2]], q)
+    (diagonal(&a), q)
 }
 
-fn mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    c
-}
-
-fn transpose(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut t = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            t[i][j] = a[j][i];
-        }
-    }
-    t
-}
-
-fn det(a: &[[f64; 3]; 3]) -> f64 {
-    a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
-}
-
-/// The unit quaternion (x, y, z, w) of a rotation matrix (Shepperd's method: the
-/// largest of the four squared components first, for accuracy).
-pub fn quaternion_of(r: &[[f64; 3]; 3]) -> [f64; 4] {
-    let t = r[0][0] + r[1][1] + r[2][2];
-    let q = if t > r[0][0].max(r[1][1]).max(r[2][2]) {
+/// The unit quaternion of a rotation matrix (Shepperd's method: the largest of
+/// the four squared components first, for accuracy). Not glam's
+/// `DQuat::from_mat3`: this is the operation order of the f32 twin
+/// (`backend::cpu::bodies::quaternion_of`, and `lib/rigid.wgsl`).
+pub fn quaternion_of(r: &DMat3) -> DQuat {
+    let e = |i: usize, j: usize| at(r, i, j);
+    let t = e(0, 0) + e(1, 1) + e(2, 2);
+    let q = if t > e(0, 0).max(e(1, 1)).max(e(2, 2)) {
         let w = 0.5 * (1.0 + t).sqrt();
         let f = 0.25 / w;
-        [
-            (r[2][1] - r[1][2]) * f,
-            (r[0][2] - r[2][0]) * f,
-            (r[1][0] - r[0][1]) * f,
+        DVec4::new(
+            (e(2, 1) - e(1, 2)) * f,
+            (e(0, 2) - e(2, 0)) * f,
+            (e(1, 0) - e(0, 1)) * f,
             w,
-        ]
-    } else if r[0][0] >= r[1][1] && r[0][0] >= r[2][2] {
-        let x = 0.5 * (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt();
+        )
+    } else if e(0, 0) >= e(1, 1) && e(0, 0) >= e(2, 2) {
+        let x = 0.5 * (1.0 + e(0, 0) - e(1, 1) - e(2, 2)).sqrt();
         let f = 0.25 / x;
-        [
+        DVec4::new(
             x,
-            (r[0][1] + r[1][0]) * f,
-            (r[0][2] + r[2][0]) * f,
-            (r[2][1] - r[1][2]) * f,
-        ]
-    } else if r[1][1] >= r[2][2] {
-        let y = 0.5 * (1.0 - r[0][0] + r[1][1] - r[2][2]).sqrt();
+            (e(0, 1) + e(1, 0)) * f,
+            (e(0, 2) + e(2, 0)) * f,
+            (e(2, 1) - e(1, 2)) * f,
+        )
+    } else if e(1, 1) >= e(2, 2) {
+        let y = 0.5 * (1.0 - e(0, 0) + e(1, 1) - e(2, 2)).sqrt();
         let f = 0.25 / y;
-        [
-            (r[0][1] + r[1][0]) * f,
+        DVec4::new(
+            (e(0, 1) + e(1, 0)) * f,
             y,
-            (r[1][2] + r[2][1]) * f,
-            (r[0][2] - r[2][0]) * f,
-        ]
+            (e(1, 2) + e(2, 1)) * f,
+            (e(0, 2) - e(2, 0)) * f,
+        )
     } else {
-        let z = 0.5 * (1.0 - r[0][0] - r[1][1] + r[2][2]).sqrt();
+        let z = 0.5 * (1.0 - e(0, 0) - e(1, 1) + e(2, 2)).sqrt();
         let f = 0.25 / z;
-        [
-            (r[0][2] + r[2][0]) * f,
-            (r[1][2] + r[2][1]) * f,
+        DVec4::new(
+            (e(0, 2) + e(2, 0)) * f,
+            (e(1, 2) + e(2, 1)) * f,
             z,
-            (r[1][0] - r[0][1]) * f,
-        ]
+            (e(1, 0) - e(0, 1)) * f,
+        )
     };
-    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
+    DQuat::from_vec4(q / q.length())
 }
 
-/// v rotated by the unit quaternion q (f64).
-pub fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let u = [q[0], q[1], q[2]];
-    let t = cross(u, v).map(|c| 2.0 * c);
-    let ut = cross(u, t);
-    [
-        v[0] + q[3] * t[0] + ut[0],
-        v[1] + q[3] * t[1] + ut[1],
-        v[2] + q[3] * t[2] + ut[2],
-    ]
-}
-
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+/// v rotated by the unit quaternion q (f64): v + w t + u × t with t = 2 u × v,
+/// the f32 twin's formula (glam's `q * v` orders the operations otherwise).
+pub fn rotate(q: DQuat, v: DVec3) -> DVec3 {
+    let u = q.xyz();
+    let t = 2.0 * u.cross(v);
+    v + q.w * t + u.cross(t)
 }
 
 /// I_r per unit mass of one particle (see `mass_properties`).
@@ -189,6 +157,11 @@ pub fn particle_inertia(dim: u32, dx: f64) -> f64 {
     } else {
         0.5 * dx * dx / std::f64::consts::PI
     }
+}
+
+/// A vector and a fourth component rounded to f32, as the body table holds them.
+fn f32x4(v: DVec3, w: f64) -> [f32; 4] {
+    [v.x as f32, v.y as f32, v.z as f32, w as f32]
 }
 
 /// Builds the body table: `body_of[i]` is particle i's body (`NO_BODY`: none),
@@ -209,58 +182,37 @@ pub fn assemble(m: &Model, st: &mut State, body_of: &[u32]) {
     let ip = particle_inertia(m.dim, m.dx);
     for (k, spec) in m.bodies.iter().enumerate() {
         let idx: Vec<usize> = members[k].iter().map(|&id| id as usize).collect();
-        let x: Vec<[f64; 3]> = idx
+        let x: Vec<DVec3> = idx
             .iter()
             .map(|&i| {
-                [
-                    st.pos[i][0] as f64,
-                    st.pos[i][1] as f64,
-                    st.pos[i][2] as f64,
-                ]
+                let p = st.pos[i];
+                DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
             })
             .collect();
         let mass: Vec<f64> = idx.iter().map(|&i| st.mass[i] as f64).collect();
         let mp = mass_properties(&x, &mass, ip);
         let (moments, axes) = principal_axes(mp.inertia);
         let q = quaternion_of(&axes);
-        let conj = [-q[0], -q[1], -q[2], q[3]];
+        let (velocity, omega) = (
+            DVec3::from(spec.velocity),
+            DVec3::from(spec.angular_velocity),
+        );
         // Angular momentum Q (I_p (Qᵀ ω)).
-        let w_body = rotate(conj, spec.angular_velocity);
-        let l = rotate(q, [0, 1, 2].map(|a| moments[a] * w_body[a]));
+        let l = rotate(q, moments * rotate(q.conjugate(), omega));
         for (&i, xi) in idx.iter().zip(&x) {
-            let r = [
-                xi[0] - mp.center[0],
-                xi[1] - mp.center[1],
-                xi[2] - mp.center[2],
-            ];
-            let r0 = rotate(conj, r);
-            st.body_offset[i] = [r0[0] as f32, r0[1] as f32, r0[2] as f32, 0.0];
-            let u = cross(spec.angular_velocity, r);
+            let r = *xi - mp.center;
+            st.body_offset[i] = f32x4(rotate(q.conjugate(), r), 0.0);
+            let u = velocity + omega.cross(r);
             for a in 0..3 {
-                st.vel[i][a] = (spec.velocity[a] + u[a]) as f32;
+                st.vel[i][a] = u[a] as f32;
             }
         }
         st.bodies.push(Body {
-            x: [
-                mp.center[0] as f32,
-                mp.center[1] as f32,
-                mp.center[2] as f32,
-                mp.mass as f32,
-            ],
-            q: q.map(|c| c as f32),
-            v: [
-                spec.velocity[0] as f32,
-                spec.velocity[1] as f32,
-                spec.velocity[2] as f32,
-                0.0,
-            ],
-            l: [l[0] as f32, l[1] as f32, l[2] as f32, 0.0],
-            inertia: [
-                moments[0] as f32,
-                moments[1] as f32,
-                moments[2] as f32,
-                ip as f32,
-            ],
+            x: f32x4(mp.center, mp.mass),
+            q: q.to_array().map(|c| c as f32),
+            v: f32x4(velocity, 0.0),
+            l: f32x4(l, 0.0),
+            inertia: f32x4(moments, ip),
             force: [0.0; 4],
             torque: [0.0; 4],
             first: st.members.len() as u32,
@@ -337,16 +289,16 @@ impl BodyTally {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyMotion {
     /// Centre of mass, world coordinates (m).
-    pub position: [f64; 3],
-    /// Orientation quaternion (x, y, z, w), body (principal) frame to world.
-    pub orientation: [f64; 4],
-    pub velocity: [f64; 3],
+    pub position: DVec3,
+    /// Orientation, body (principal) frame to world.
+    pub orientation: DQuat,
+    pub velocity: DVec3,
     /// World frame (rad/s).
-    pub angular_velocity: [f64; 3],
+    pub angular_velocity: DVec3,
     /// World frame (kg m²/s).
-    pub angular_momentum: [f64; 3],
+    pub angular_momentum: DVec3,
     /// The same in the body (principal) frame.
-    pub body_angular_momentum: [f64; 3],
+    pub body_angular_momentum: DVec3,
     pub mass: f64,
     /// Rotational kinetic energy ½ L·ω (J).
     pub rotational_energy: f64,
@@ -354,31 +306,27 @@ pub struct BodyMotion {
 
 impl BodyMotion {
     pub fn of(m: &Model, b: &Body) -> BodyMotion {
-        let q = b.q.map(|c| c as f64);
-        let l = [b.l[0] as f64, b.l[1] as f64, b.l[2] as f64];
-        let lb = rotate([-q[0], -q[1], -q[2], q[3]], l);
-        let inertia = [
-            b.inertia[0] as f64,
-            b.inertia[1] as f64,
-            b.inertia[2] as f64,
-        ];
-        let w_body = [0, 1, 2].map(|a| {
+        let xyz = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+        let q = DQuat::from_array(b.q.map(|c| c as f64));
+        let l = xyz(b.l);
+        let lb = rotate(q.conjugate(), l);
+        let inertia = xyz(b.inertia);
+        let w_body = DVec3::from_array([0, 1, 2].map(|a| {
             if inertia[a] > 0.0 {
                 lb[a] / inertia[a]
             } else {
                 0.0
             }
-        });
-        let energy = 0.5 * (0..3).map(|a| lb[a] * w_body[a]).sum::<f64>();
+        }));
         BodyMotion {
-            position: m.to_world(b.x),
+            position: DVec3::from(m.to_world(b.x)),
             orientation: q,
-            velocity: [b.v[0] as f64, b.v[1] as f64, b.v[2] as f64],
+            velocity: xyz(b.v),
             angular_velocity: rotate(q, w_body),
             angular_momentum: l,
             body_angular_momentum: lb,
             mass: b.x[3] as f64,
-            rotational_energy: energy,
+            rotational_energy: 0.5 * lb.dot(w_body),
         }
     }
 }
@@ -397,36 +345,36 @@ mod tests {
         for i in 0..3 {
             for j in 0..2 {
                 let (px, py) = (i as f64 - 1.0, j as f64 - 0.5);
-                x.push([c * px - s * py, s * px + c * py, 0.0]);
+                x.push(DVec3::new(c * px - s * py, s * px + c * py, 0.0));
             }
         }
         let m = vec![1.0; x.len()];
         let mp = mass_properties(&x, &m, 0.0);
         let (moments, q) = principal_axes(mp.inertia);
         // Axis-aligned: I_xx = Σ y² = 1.5, I_yy = Σ x² = 4, I_zz = 5.5.
-        let mut sorted = moments;
+        let mut sorted = moments.to_array();
         sorted.sort_by(|a, b| a.partial_cmp(b).unwrap());
         for (got, want) in sorted.iter().zip([1.5, 4.0, 5.5]) {
             assert!((got - want).abs() < 1e-12, "{moments:?}");
         }
         // z stays a principal axis exactly (a planar body).
-        assert_eq!(q[2][2].abs(), 1.0);
-        assert!((det(&q) - 1.0).abs() < 1e-12);
+        assert_eq!(at(&q, 2, 2).abs(), 1.0);
+        assert!((q.determinant() - 1.0).abs() < 1e-12);
         // Qᵀ I Q is diagonal.
-        let d = mul(&transpose(&q), &mul(&mp.inertia, &q));
-        assert!(d[0][1].abs() < 1e-12 && d[0][2].abs() < 1e-12 && d[1][2].abs() < 1e-12);
+        let d = q.transpose() * (mp.inertia * q);
+        assert!(
+            at(&d, 0, 1).abs() < 1e-12 && at(&d, 0, 2).abs() < 1e-12 && at(&d, 1, 2).abs() < 1e-12
+        );
     }
 
     #[test]
     fn quaternion_reproduces_its_rotation_matrix() {
-        let (_, q) = principal_axes([[2.0, 0.3, -0.2], [0.3, 1.0, 0.4], [-0.2, 0.4, 3.0]]);
+        let a = DMat3::from_cols_array_2d(&[[2.0, 0.3, -0.2], [0.3, 1.0, 0.4], [-0.2, 0.4, 3.0]]);
+        let (_, q) = principal_axes(a);
         let quat = quaternion_of(&q);
         for col in 0..3 {
-            let e = [0, 1, 2].map(|a| if a == col { 1.0 } else { 0.0 });
-            let r = rotate(quat, e);
-            for a in 0..3 {
-                assert!((r[a] - q[a][col]).abs() < 1e-12);
-            }
+            let r = rotate(quat, DVec3::AXES[col]);
+            assert!((r - q.col(col)).abs().max_element() < 1e-12);
         }
     }
 }

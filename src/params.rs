@@ -86,19 +86,19 @@ gpu_struct! {
     /// The cell grid (grid-relative coordinates: the domain's lower corner is 0).
     pub struct Grid {
         /// Cells along x, y, z (w unused).
-        pub cells: [u32; 4],
+        pub cells: glam::UVec4,
         /// 1 / cell size per axis.
-        pub cell_inv: [f32; 4],
+        pub cell_inv: glam::Vec4,
         /// Period length per axis (0 where not periodic).
-        pub period: [f32; 4],
+        pub period: glam::Vec4,
         /// Half the period per axis, for the minimum-image test.
-        pub half_period: [f32; 4],
+        pub half_period: glam::Vec4,
         /// A particle below `keep_lo` or above `keep_hi` on an axis has left the
         /// simulation (issue 18): at an open face, or (wall_layers + 1) Δx behind a
         /// walled one, the edge of the padded box; ±f32::MAX on periodic and
         /// absent axes.
-        pub keep_lo: [f32; 4],
-        pub keep_hi: [f32; 4],
+        pub keep_lo: glam::Vec4,
+        pub keep_hi: glam::Vec4,
     }
 }
 
@@ -115,8 +115,6 @@ gpu_struct! {
         pub support2: f32,
         /// η² = 0.01 h², the Cleary–Monaghan regularisation of 1/r² terms.
         pub eta2: f32,
-        pub pad0: f32,
-        pub pad1: f32,
     }
 }
 
@@ -137,7 +135,6 @@ gpu_struct! {
         pub capillary_limit: f32,
         /// 0.22 √(m/k_c), the body contact limit (F22 (42)).
         pub contact_limit: f32,
-        pub pad2: f32,
     }
 }
 
@@ -145,7 +142,7 @@ gpu_struct! {
     /// Body force, transport velocity, interface viscosity and the wall pass.
     pub struct Flow {
         /// Gravity xyz (w unused).
-        pub gravity: [f32; 4],
+        pub gravity: glam::Vec4,
         /// Transport-velocity background pressure p_b (Adami 2013).
         pub background_pressure: f32,
         /// F22 (32) interface viscosity α_0^lg (0 = off).
@@ -171,8 +168,6 @@ gpu_struct! {
         pub inv_kappa: f32,
         /// T_ambient⁴ for radiation.
         pub ambient_t4: f32,
-        pub pad0: f32,
-        pub pad1: f32,
     }
 }
 
@@ -193,30 +188,29 @@ gpu_struct! {
         pub gas: u32,
         /// Free-surface form: |κ| ≤ 1/support (R18's cap 1/(2h) of Wendland); 0 otherwise.
         pub kappa_max: f32,
-        pub pad0: f32,
-        pub pad1: f32,
-        pub pad2: u32,
     }
 }
 
 gpu_struct! {
     /// One point of the scan path.
     pub struct PathPoint {
+        /// Aligned to 16, so the array's stride is the 16 bytes the uniform
+        /// address space asks of an array.
+        #[shader(align(16))]
         pub time: f32,
         /// Lateral beam centre, grid-relative (y is 0 in 2D).
         pub x: f32,
         pub y: f32,
-        pub pad0: f32,
     }
 }
 
 gpu_struct! {
     /// One step of the power schedule: `power` from `time` on.
     pub struct PowerStep {
+        /// Aligned to 16: the uniform array stride, as in `PathPoint`.
+        #[shader(align(16))]
         pub time: f32,
         pub power: f32,
-        pub pad0: f32,
-        pub pad1: f32,
     }
 }
 
@@ -240,14 +234,18 @@ gpu_struct! {
         /// Column cross-section Δx^(d−1).
         pub column_area: f32,
         /// Bins per axis (1 beyond the dimension; w unused).
-        pub bins: [u32; 4],
+        pub bins: glam::UVec4,
         /// Lower corner of the bin grid, grid-relative.
-        pub lo: [f32; 4],
+        pub lo: glam::Vec4,
         pub path_points: u32,
         pub power_steps: u32,
-        pub pad0: u32,
-        pub pad1: u32,
+        /// The arrays' own align(16) is what their 16-aligned elements imply by
+        /// WGSL's rules (encase follows them); naga 30 takes a struct's alignment
+        /// from its members' types and not their `@align`, so without it naga
+        /// (and so the GPU) would start `path` at 72, encase at 80.
+        #[shader(align(16))]
         pub path: [PathPoint; MAX_LASER_POINTS],
+        #[shader(align(16))]
         pub power: [PowerStep; MAX_LASER_POINTS],
     }
 }
@@ -264,7 +262,7 @@ gpu_struct! {
         /// KIND_LIQUID, KIND_GAS, KIND_WALL or KIND_SOLID.
         pub kind: u32,
         /// Wall velocity xyz (w unused).
-        pub velocity: [f32; 4],
+        pub velocity: glam::Vec4,
         /// Solid conductivity k_s.
         pub conductivity: f32,
         /// Solid heat capacity c_s.
@@ -310,8 +308,6 @@ gpu_struct! {
         /// fixed temperature is its own, in heat.x.)
         pub contact_cos: f32,
         pub contact_sin: f32,
-        pub pad1: f32,
-        pub pad2: f32,
     }
 }
 
@@ -344,8 +340,6 @@ gpu_struct! {
         pub delta_hc: f32,
         /// δ-SPH: 2 (d + 2) of the Monaghan–Marrone viscosity R18 (3.18).
         pub viscosity_factor: f32,
-        pub pad0: f32,
-        pub pad1: f32,
     }
 }
 
@@ -391,20 +385,27 @@ gpu_struct! {
         /// The rigid bodies' Jacobi rotations leave an off-diagonal entry at or
         /// below this fraction of its diagonal pair (f32 rounding).
         pub jacobi_floor: f32,
-        pub pad1: f32,
-        pub pad2: f32,
     }
 }
 
 gpu_struct! {
-    /// The whole block, bound as `P` in every pass.
+    /// The whole block, bound as `P` in every pass. encase places each member
+    /// by WGSL's rules; the uniform address space also wants a struct member at
+    /// a multiple of 16 and at least its predecessor's size rounded up to 16
+    /// past it, which the members after the structs of only 4-byte members
+    /// (`kernel`, `surfaces`) state as `align(16)`, as the WGSL does (encase
+    /// checks it on every write). The others follow a struct with a vec4 (its
+    /// alignment is 16) or one whose size is a multiple of 16 (`sizes`,
+    /// `bodies`).
     pub struct Params {
         pub sizes: Sizes,
         pub grid: Grid,
         pub kernel: Kernel,
+        #[shader(align(16))]
         pub time_step: TimeStep,
         pub flow: Flow,
         pub surfaces: Surfaces,
+        #[shader(align(16))]
         pub tension: Tension,
         pub laser: Laser,
         pub bodies: Bodies,
@@ -451,8 +452,6 @@ pub const SHADER_CONSTS: Consts = {
         four: 4.0,
         tenth: 0.1,
         jacobi_floor: 1e-7,
-        pad1: 0.0,
-        pad2: 0.0,
     }
 };
 
@@ -472,6 +471,14 @@ pub fn kernel_sigma(kind: KernelKind, dim: u32, h: f64) -> f64 {
 }
 
 impl Params {
+    /// The block's bytes in the uniform layout (encase: WGSL's offsets, zero
+    /// padding between members), as the passes bind it.
+    pub fn uniform_bytes(&self) -> Vec<u8> {
+        let mut buf = encase::UniformBuffer::new(Vec::<u8>::new());
+        buf.write(self)
+            .expect("the parameter block fits a growable buffer");
+        buf.into_inner()
+    }
     pub fn new(m: &Model, n_particles: u32) -> Params {
         let mut p = Params::zeroed();
         p.sizes = Sizes {
@@ -488,8 +495,6 @@ impl Params {
             sigma: kernel_sigma(m.kernel, m.dim, m.h) as f32,
             support2: (m.support * m.support) as f32,
             eta2: (0.01 * m.h * m.h) as f32,
-            pad0: 0.0,
-            pad1: 0.0,
         };
         p.time_step = TimeStep {
             max_sound_speed: m.max_sound_speed() as f32,
@@ -499,15 +504,14 @@ impl Params {
             barrier_limit: finite_or_max(m.limits.barrier),
             capillary_limit: finite_or_max(m.limits.capillary),
             contact_limit: finite_or_max(m.limits.contact),
-            pad2: 0.0,
         };
         p.flow = Flow {
-            gravity: [
+            gravity: glam::Vec4::new(
                 m.gravity[0] as f32,
                 m.gravity[1] as f32,
                 m.gravity[2] as f32,
                 0.0,
-            ],
+            ),
             background_pressure: m.background_pressure as f32,
             interface_viscosity: 0.0,
             wall_weight_floor: 0.0,
@@ -542,8 +546,6 @@ impl Params {
                 .delta
                 .map_or(0.0, |d| (d * m.h * m.max_sound_speed()) as f32),
             viscosity_factor: (2.0 * (m.dim as f64 + 2.0)) as f32,
-            pad0: 0.0,
-            pad1: 0.0,
         };
         if m.delta.is_some() {
             p.sizes.flags |= FLAG_CONTINUITY;
@@ -832,11 +834,11 @@ fn laser_block(m: &Model) -> Laser {
             .ceil()
             .max(1.0) as u32;
     }
-    p.bins = bins;
+    p.bins = bins.into();
     p.path_points = l.path.len() as u32;
     p.power_steps = l.power.len() as u32;
     let lo = m.to_local(m.domain_lo);
-    p.lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
+    p.lo = glam::Vec4::new(lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0);
     for (k, (t, x)) in l.path.iter().enumerate() {
         let mut abs = m.domain_lo;
         abs[0] = x[0];
@@ -848,15 +850,12 @@ fn laser_block(m: &Model) -> Laser {
             time: *t as f32,
             x: loc[0] as f32,
             y: if m.dim == 3 { loc[1] as f32 } else { 0.0 },
-            pad0: 0.0,
         };
     }
     for (k, (t, pw)) in l.power.iter().enumerate() {
         p.power[k] = PowerStep {
             time: *t as f32,
             power: *pw as f32,
-            pad0: 0.0,
-            pad1: 0.0,
         };
     }
     p
@@ -884,12 +883,12 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
         PhaseKind::Wall => KIND_WALL,
         PhaseKind::Solid => KIND_SOLID,
     };
-    b.velocity = [
+    b.velocity = glam::Vec4::new(
         ph.velocity[0] as f32,
         ph.velocity[1] as f32,
         ph.velocity[2] as f32,
         0.0,
-    ];
+    );
     if ph.slip == Slip::FreeSlip {
         b.flags |= PHASE_FREE_SLIP;
     }

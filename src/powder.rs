@@ -25,13 +25,15 @@
 use crate::error::InputError;
 use crate::random::SplitMix;
 use crate::scene::PowderDef;
+use glam::DVec3;
 
 /// Consecutive grains removed by the levelling before pouring stops.
 const POUR_MISSES: usize = 200;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Grain {
-    pub center: [f64; 3],
+    /// In 2D the last component is 0.
+    pub center: DVec3,
     pub radius: f64,
 }
 
@@ -126,9 +128,10 @@ impl PowderBed {
 
     /// The grain whose sphere holds x, if any.
     pub fn grain_at(&self, x: [f64; 3], dim: usize) -> Option<usize> {
+        let x = DVec3::from(x);
         self.grid
             .near(x)
-            .find(|&k| dist2(&self.grains[k].center, &x, dim) <= self.grains[k].radius.powi(2))
+            .find(|&k| dist2(self.grains[k].center, x, dim) <= self.grains[k].radius.powi(2))
     }
 
     /// The one-line summary `validate` and `run` print.
@@ -160,22 +163,28 @@ impl PowderBed {
     }
 }
 
-fn dist2(a: &[f64; 3], b: &[f64; 3], dim: usize) -> f64 {
-    (0..dim).map(|k| (a[k] - b[k]).powi(2)).sum()
+/// |a − b|² over the first `dim` axes.
+fn dist2(a: DVec3, b: DVec3, dim: usize) -> f64 {
+    let d = a - b;
+    if dim == 2 {
+        d.truncate().length_squared()
+    } else {
+        d.length_squared()
+    }
 }
 
 /// Uniform cells over the box's lateral extent and height, each listing the
 /// grains whose bounding box touches it.
 #[derive(Debug, Clone, PartialEq)]
 struct Grid {
-    lo: [f64; 3],
+    lo: DVec3,
     size: f64,
     n: [usize; 3],
     cells: Vec<Vec<usize>>,
 }
 
 impl Grid {
-    fn new(lo: [f64; 3], hi: [f64; 3], size: f64, dim: usize) -> Grid {
+    fn new(lo: DVec3, hi: DVec3, size: f64, dim: usize) -> Grid {
         let mut n = [1; 3];
         for k in 0..dim {
             n[k] = (((hi[k] - lo[k]) / size).ceil() as usize).max(1);
@@ -187,7 +196,7 @@ impl Grid {
             cells: vec![Vec::new(); n[0] * n[1] * n[2]],
         }
     }
-    fn cell(&self, x: [f64; 3]) -> [usize; 3] {
+    fn cell(&self, x: DVec3) -> [usize; 3] {
         let mut c = [0; 3];
         for k in 0..3 {
             let i = ((x[k] - self.lo[k]) / self.size).floor();
@@ -199,9 +208,8 @@ impl Grid {
         (c[2] * self.n[1] + c[1]) * self.n[0] + c[0]
     }
     fn insert(&mut self, k: usize, g: &Grain) {
-        let r = [g.radius; 3];
-        let a = self.cell([g.center[0] - r[0], g.center[1] - r[1], g.center[2] - r[2]]);
-        let b = self.cell([g.center[0] + r[0], g.center[1] + r[1], g.center[2] + r[2]]);
+        let a = self.cell(g.center - g.radius);
+        let b = self.cell(g.center + g.radius);
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 for x in a[0]..=b[0] {
@@ -212,13 +220,13 @@ impl Grid {
         }
     }
     /// Grains listed in x's cell (every grain that can hold x).
-    fn near(&self, x: [f64; 3]) -> impl Iterator<Item = usize> + '_ {
+    fn near(&self, x: DVec3) -> impl Iterator<Item = usize> + '_ {
         self.cells[self.index(self.cell(x))].iter().copied()
     }
     /// Grains listed within `reach` of x (candidates for contact).
-    fn around(&self, x: [f64; 3], reach: f64) -> Vec<usize> {
-        let a = self.cell([x[0] - reach, x[1] - reach, x[2] - reach]);
-        let b = self.cell([x[0] + reach, x[1] + reach, x[2] + reach]);
+    fn around(&self, x: DVec3, reach: f64) -> Vec<usize> {
+        let a = self.cell(x - reach);
+        let b = self.cell(x + reach);
         let mut out = Vec::new();
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
@@ -236,7 +244,7 @@ impl Grid {
 /// Pours the bed a `[powder]` section describes.
 pub fn pour(spec: PowderSpec, dim: usize) -> PowderBed {
     let up = dim - 1;
-    let (lo, hi) = (spec.lo, spec.hi);
+    let (lo, hi) = (DVec3::from(spec.lo), DVec3::from(spec.hi));
     let d_max = spec.diameters.max;
     // The grid reaches a grain diameter above the levelling height: grains
     // enter there before settling.
@@ -254,7 +262,7 @@ pub fn pour(spec: PowderSpec, dim: usize) -> PowderBed {
     let mut bed_top = lo[up];
     while misses < POUR_MISSES && spec.max_grains.is_none_or(|m| grains.len() < m) {
         let radius = 0.5 * spec.diameters.sample(&mut rng);
-        let mut x = [0.0; 3];
+        let mut x = DVec3::ZERO;
         for k in 0..up {
             x[k] = lo[k] + radius + rng.next_f64() * (hi[k] - lo[k] - 2.0 * radius);
         }
@@ -298,7 +306,7 @@ pub fn pour(spec: PowderSpec, dim: usize) -> PowderBed {
 fn settle(
     grains: &[Grain],
     grid: &Grid,
-    mut x: [f64; 3],
+    mut x: DVec3,
     r: f64,
     spec: &PowderSpec,
     dim: usize,
@@ -342,7 +350,7 @@ const SETTLE_STEPS: usize = 200_000;
 /// Raises x until it overlaps no grain beyond the tolerance (a safety net: the
 /// accepted descent steps end clear): for each overlap, the height at which the
 /// two spheres just touch above the other's centre. Only ever up, so it ends.
-fn lift_clear(x: &mut [f64; 3], r: f64, grains: &[Grain], near: &[usize], dim: usize) {
+fn lift_clear(x: &mut DVec3, r: f64, grains: &[Grain], near: &[usize], dim: usize) {
     let up = dim - 1;
     loop {
         let mut lifted = false;
@@ -351,7 +359,7 @@ fn lift_clear(x: &mut [f64; 3], r: f64, grains: &[Grain], near: &[usize], dim: u
             let reach = r + g.radius;
             // The projection's tolerance: a side contact within it is a
             // contact, and lifting would float the grain off the floor.
-            if dist2(x, &g.center, dim) >= (reach * (1.0 - OVERLAP_TOLERANCE)).powi(2) {
+            if dist2(*x, g.center, dim) >= (reach * (1.0 - OVERLAP_TOLERANCE)).powi(2) {
                 continue;
             }
             let lateral: f64 = (0..up).map(|a| (x[a] - g.center[a]).powi(2)).sum();
@@ -372,7 +380,7 @@ fn lift_clear(x: &mut [f64; 3], r: f64, grains: &[Grain], near: &[usize], dim: u
 /// last sweep found no overlap deeper than 1e-9 of the radius (a wedge between
 /// the floor and a grain converges slowly: such a trial counts as blocked).
 fn project(
-    x: &mut [f64; 3],
+    x: &mut DVec3,
     r: f64,
     grains: &[Grain],
     near: &[usize],
@@ -389,14 +397,13 @@ fn project(
         let mut moved = false;
         for &k in near {
             let g = &grains[k];
-            let d2 = dist2(x, &g.center, dim);
+            let d2 = dist2(*x, g.center, dim);
             let reach = r + g.radius;
             if d2 < (reach * (1.0 - OVERLAP_TOLERANCE)).powi(2) {
                 let d = d2.sqrt().max(1e-12 * reach);
-                let push = (reach - d) / d;
-                for a in 0..dim {
-                    x[a] += (x[a] - g.center[a]) * push;
-                }
+                // Out along the centre line to the contact distance (in 2D the
+                // last components are 0 and stay 0).
+                *x += (*x - g.center) * ((reach - d) / d);
                 moved = true;
             }
         }
@@ -585,7 +592,7 @@ mod tests {
                 assert!(g.center[a] + g.radius <= b.spec.hi[a] + 1e-12);
             }
             for h in &b.grains[..i] {
-                let d = dist2(&g.center, &h.center, 3).sqrt();
+                let d = dist2(g.center, h.center, 3).sqrt();
                 assert!(d >= (g.radius + h.radius) * (1.0 - 1e-9), "overlap {d}");
             }
         }
@@ -607,7 +614,7 @@ mod tests {
         let tol = 10.0 * SETTLE_PRECISION * g.radius;
         let mut out = Vec::new();
         for (j, h) in b.grains.iter().enumerate() {
-            let d = dist2(&g.center, &h.center, dim).sqrt();
+            let d = dist2(g.center, h.center, dim).sqrt();
             if j != i && d - g.radius - h.radius < tol {
                 let mut n = [0.0; 3];
                 for a in 0..dim {

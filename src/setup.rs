@@ -9,6 +9,7 @@ use crate::model::{BodySource, Model};
 use crate::random::SplitMix;
 use crate::scene::{SceneFile, ShapeDef};
 use crate::state::{State, BYTES_PER_CELL, BYTES_PER_PARTICLE_SORT, NO_BODY};
+use glam::DVec3;
 
 /// Lattice coordinates along one axis: positions and whether each is in a wall layer.
 fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
@@ -69,27 +70,29 @@ pub fn available_memory() -> Option<f64> {
     Some(kb * 1024.0)
 }
 
-fn inside(shape: &ShapeDef, x: [f64; 3], dim: usize) -> bool {
+/// A shape's point or direction (`dim` components) as a DVec3, 0 beyond `dim`
+/// like the lattice sites.
+fn vec3(v: &[f64]) -> DVec3 {
+    let mut a = [0.0; 3];
+    a[..v.len()].copy_from_slice(v);
+    DVec3::from(a)
+}
+
+fn inside(shape: &ShapeDef, x: DVec3, dim: usize) -> bool {
     if let Some(b) = &shape.box_ {
         return (0..dim).all(|a| x[a] >= b.min[a] && x[a] <= b.max[a]);
     }
     if let Some(s) = &shape.sphere {
-        let d2: f64 = (0..dim).map(|a| (x[a] - s.center[a]).powi(2)).sum();
-        return d2 <= s.radius * s.radius;
+        return x.distance_squared(vec3(&s.center)) <= s.radius * s.radius;
     }
     if let Some(c) = &shape.cylinder {
-        let len2: f64 = (0..dim).map(|a| c.axis[a] * c.axis[a]).sum();
-        let t: f64 = (0..dim)
-            .map(|a| (x[a] - c.base[a]) * c.axis[a])
-            .sum::<f64>()
-            / len2;
+        // t: where x projects onto the axis (0 at the base, 1 at its end).
+        let (base, axis) = (vec3(&c.base), vec3(&c.axis));
+        let t = (x - base).dot(axis) / axis.length_squared();
         if !(0.0..=1.0).contains(&t) {
             return false;
         }
-        let d2: f64 = (0..dim)
-            .map(|a| (x[a] - c.base[a] - t * c.axis[a]).powi(2))
-            .sum();
-        return d2 <= c.radius * c.radius;
+        return (x - base - t * axis).length_squared() <= c.radius * c.radius;
     }
     false
 }
@@ -288,7 +291,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
                         .enumerate()
                         .zip(&shape_phase)
                         .rev()
-                        .find(|((_, s), _)| inside(s, p, m.dim as usize))
+                        .find(|((_, s), _)| inside(s, DVec3::from(p), m.dim as usize))
                         .map_or((None, None), |(s, &pi)| (Some(pi), Some(s)))
                 };
                 let Some(pi) = phase else { continue };

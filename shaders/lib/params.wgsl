@@ -26,8 +26,6 @@ struct Kernel {
     sigma: f32,              // normalisation
     support2: f32,           // support radius squared
     eta2: f32,               // 0.01 h², regularises 1/r² terms
-    pad0: f32,
-    pad1: f32,
 }
 
 struct TimeStep {
@@ -38,7 +36,6 @@ struct TimeStep {
     barrier_limit: f32,      // 0.22 sqrt(m/k_b)
     capillary_limit: f32,    // 0.25 sqrt(rho h^3/(2 pi alpha))
     contact_limit: f32,      // 0.22 sqrt(m/k_c)
-    pad2: f32,
 }
 
 struct Flow {
@@ -63,30 +60,22 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     liquid: u32,
     gas: u32,                // NO_PHASE in the free-surface form
     kappa_max: f32,          // free-surface form: |kappa| <= 1/support
-    pad0: f32,
-    pad1: f32,
-    pad2: u32,
 }
 
 struct Surfaces {
     inv_kappa: f32,          // 1 / kappa, the surface delta's normalisation
     ambient_t4: f32,         // T_ambient^4 for radiation
-    pad0: f32,
-    pad1: f32,
 }
 
 struct PathPoint {
-    time: f32,
+    @align(16) time: f32,    // 16: the uniform array stride
     x: f32,                  // lateral beam centre (grid-relative)
     y: f32,
-    pad0: f32,
 }
 
 struct PowerStep {
-    time: f32,
+    @align(16) time: f32,    // 16: the uniform array stride
     power: f32,              // from `time` on
-    pad0: f32,
-    pad1: f32,
 }
 
 struct Laser {
@@ -102,10 +91,10 @@ struct Laser {
     lo: vec4<f32>,           // bin grid lower corner (grid-relative)
     path_points: u32,
     power_steps: u32,
-    pad0: u32,
-    pad1: u32,
-    path: array<PathPoint, 8>,
-    power: array<PowerStep, 8>,
+    // @align(16): naga takes a struct's alignment from its members' types, not
+    // their @align, so PathPoint's own would not place the array (params.rs).
+    @align(16) path: array<PathPoint, 8>,
+    @align(16) power: array<PowerStep, 8>,
 }
 
 struct Bodies {              // rigid bodies, F22 (39)-(40) contact (FLAG_BODIES)
@@ -122,8 +111,6 @@ struct Solve {                // the formulation and its solvers (backend::sched
     heat_max_iterations: u32,
     delta_hc: f32,            // delta h c0, R18 (3.53)
     viscosity_factor: f32,    // 2 (d + 2), R18 (3.18)
-    pad0: f32,
-    pad1: f32,
 }
 
 struct Phase {
@@ -155,8 +142,6 @@ struct Phase {
     contact_cos: f32,        // F22 (27): cos, sin of the liquid's contact angle on
     contact_sin: f32,        // this wall/solid phase (FLAG_WETTING); a Dirichlet
                              // wall's temperature is per particle (heat.x)
-    pad1: f32,
-    pad2: f32,
 }
 
 // Arithmetic literals (see consts.wgsl).
@@ -191,18 +176,19 @@ struct Consts {
     four: f32,
     tenth: f32,
     jacobi_floor: f32,
-    pad1: f32,
-    pad2: f32,
 }
 
+// Offsets, sizes and strides follow WGSL's layout rules (encase computes the same
+// on the Rust side); @align(16) states the uniform address space's constraint on a
+// member after a struct of 4-byte members (Kernel, Surfaces), as params.rs does.
 struct Params {
     sizes: Sizes,
     grid: Grid,
     kernel: Kernel,
-    time_step: TimeStep,
+    @align(16) time_step: TimeStep,
     flow: Flow,
     surfaces: Surfaces,
-    tension: Tension,
+    @align(16) tension: Tension,
     laser: Laser,
     bodies: Bodies,
     solve: Solve,

@@ -88,7 +88,7 @@ impl super::Check for Restitution {
 /// figures printed.
 pub struct FreeRotation {
     energy_tolerance: f64,
-    l0: Option<[f64; 3]>,
+    l0: Option<glam::DVec3>,
     e0: f64,
     max_dl: f64,
     max_de: f64,
@@ -150,7 +150,7 @@ impl super::Check for FreeRotation {
         let Some(b) = st.bodies.first() else {
             return (metric, f64::NAN, vec!["needs a rigid body".into()]).into();
         };
-        let l0 = self.l0.unwrap_or([0.0; 3]);
+        let l0 = self.l0.unwrap_or(glam::DVec3::ZERO);
         let n0 = (l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]).sqrt();
         let k = intermediate_axis(b.inertia);
         let along = self.spin0.abs() / n0;

@@ -156,10 +156,10 @@ pub fn bodies_message(m: &Model, st: &State) -> serde_json::Value {
             let mo = crate::bodies::BodyMotion::of(m, b);
             serde_json::json!({
                 "body": k + 1,
-                "position": mo.position,
-                "orientation": mo.orientation,
-                "velocity": mo.velocity,
-                "angular_velocity": mo.angular_velocity,
+                "position": mo.position.to_array(),
+                "orientation": mo.orientation.to_array(),
+                "velocity": mo.velocity.to_array(),
+                "angular_velocity": mo.angular_velocity.to_array(),
                 "mass": mo.mass,
                 "particles": b.count,
                 "molten_fraction": b.molten_fraction(),

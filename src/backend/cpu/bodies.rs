@@ -139,7 +139,7 @@ fn rotate_free(b: &mut Body, dt: f32) {
 /// `body_drift`: first half kick, drift of the centre, free rotation.
 pub fn drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
-    let g = pr.flow.gravity;
+    let g = pr.flow.gravity.to_array();
     st.bodies.par_iter_mut().for_each(|b| {
         if !b.moves() {
             return;
@@ -259,7 +259,8 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                 if br && r < pr.flow.barrier_radius {
                     // F22 (34) as the forces pass applies it to the fluid from a
                     // wall particle: the wall phase's velocity, not the body's.
-                    let s = terms::barrier(pr, v_j, pr.phase(phase[i]).velocity, dj, r);
+                    let w = pr.phase(phase[i]).velocity.to_array();
+                    let s = terms::barrier(pr, v_j, w, dj, r);
                     for c in 0..3 {
                         f[c] -= s * dj[c];
                     }
@@ -327,7 +328,7 @@ pub fn sum(st: &mut State) {
 /// `body_kick`: the second half kick with the force of the new positions.
 pub fn kick(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
-    let g = pr.flow.gravity;
+    let g = pr.flow.gravity.to_array();
     st.bodies
         .par_iter_mut()
         .filter(|b| b.moves())

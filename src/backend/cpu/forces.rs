@@ -197,14 +197,14 @@ fn sweep<
                 }
                 if VH {
                     let (w, share) = if wall {
-                        (mat_j.velocity, 1.0)
+                        (mat_j.velocity.to_array(), 1.0)
                     } else {
                         (v_j, 0.5)
                     };
                     heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
                 }
                 if BR && wall && r < pr.flow.barrier_radius {
-                    let s = terms::barrier(pr, v_i, mat_j.velocity, d, r);
+                    let s = terms::barrier(pr, v_i, mat_j.velocity.to_array(), d, r);
                     for a in 0..3 {
                         f[a] += s * d[a];
                     }

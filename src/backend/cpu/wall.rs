@@ -59,7 +59,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable) {
                 }
             });
             // The wall's own velocity: its phase's, or a body particle's rigid motion.
-            let mut b = pr.phase(ph).velocity;
+            let mut b = pr.phase(ph).velocity.to_array();
             let by_id = body.get(st_id[i] as usize);
             if let Some(&k) = by_id.filter(|&&k| k != NO_BODY) {
                 let u = super::bodies::point_velocity(&bodies[k as usize], &pos[i]);

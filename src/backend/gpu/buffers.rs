@@ -223,7 +223,7 @@ impl Buffers {
         Buffers {
             params: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("params"),
-                contents: bytemuck::bytes_of(params),
+                contents: &params.uniform_bytes(),
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
             fields: FIELDS

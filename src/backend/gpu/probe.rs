@@ -70,7 +70,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
     });
     let pbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("params"),
-        contents: bytemuck::bytes_of(params),
+        contents: &params.uniform_bytes(),
         usage: wgpu::BufferUsages::UNIFORM,
     });
     let pbg = d.create_bind_group(&wgpu::BindGroupDescriptor {

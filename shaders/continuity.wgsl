@@ -1,5 +1,5 @@
 // uses: params consts kernel grid phase rigid
-// reads: pos vel mass phase id body bodies sim
+// reads: pos vel mass phase id body bodies sim heat
 // writes: rho press continuity density_gradient
 // δ-SPH density (R18 §3.1.2, (3.14) with the diffusion (3.53) and its
 // renormalisation f_l): the excess density's gradient (continuity_gradient),
@@ -7,14 +7,23 @@
 // rho += dt drho/dt and the EOS (continuity_update). Twin of src/backend/cpu/continuity.rs (equations
 // and choices there).
 
-// The EOS p = c²(rho - rho0), clamped at 0 with the pressure floor: the density
-// pass's, twin of backend::cpu::density::equation_of_state.
-fn continuity_eos(ph: u32, r: f32) -> f32 {
-    let p = P.phases[ph].c2 * (r - P.phases[ph].rho0);
+// The EOS p = c²(rho - rho0(T)), clamped at 0 with the pressure floor: the
+// density pass's with the particle's own reference density.
+fn continuity_eos(ph: u32, r: f32, rho0: f32) -> f32 {
+    let p = P.phases[ph].c2 * (r - rho0);
     if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
         return max(p, 0.0);
     }
     return p;
+}
+
+// Particle i's reference density: its phase's density law at its temperature
+// (the previous step's), else the phase's rho0.
+fn particle_rho0(ph: u32, i: u32) -> f32 {
+    if ((P.phases[ph].flags & PHASE_DENSITY_LAW) != 0u) {
+        return reference_density(ph, heat[i][H_TEMPERATURE]);
+    }
+    return P.phases[ph].rho0;
 }
 
 // The real velocity of a wall or body particle (not the wall pass's ghost).
@@ -42,8 +51,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
         density_gradient[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }
-    let rho0_i = P.phases[ph_i].rho0;
-    let excess_i = rho[i] - rho0_i;
+    let excess_i = rho[i] - particle_rho0(ph_i, i);
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
@@ -66,7 +74,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
             myy = myy - vf * d.y * d.y;
             myz = myz - vf * d.y * d.z;
             mzz = mzz - vf * d.z * d.z;
-            let db = (rho[j] - rho0_i - excess_i) * vf;
+            let db = (rho[j] - particle_rho0(ph_i, j) - excess_i) * vf;
             b.x = b.x + db * d.x;
             b.y = b.y + db * d.y;
             b.z = b.z + db * d.z;
@@ -107,7 +115,7 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     }
     let rho_i = rho[i];
     let m_i = mass[i];
-    let rho0_i = P.phases[ph_i].rho0;
+    let rho0_i = particle_rho0(ph_i, i);
     let c2_i = P.phases[ph_i].c2;
     let excess_i = rho_i - rho0_i;
     let g_i = density_gradient[i];
@@ -143,7 +151,7 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
                     let ud = (v_i.x - v_j.x) * d.x + (v_i.y - v_j.y) * d.y + (v_i.z - v_j.z) * d.z;
                     div = div + vol_j * ud * f;
                     if (ph_j == ph_i) {
-                        let dr = rho_j - rho0_i - excess_i;
+                        let dr = rho_j - particle_rho0(ph_i, j) - excess_i;
                         let gj = density_gradient[j];
                         let gd = (g_i.x + gj.x) * d.x + (g_i.y + gj.y) * d.y + (g_i.z + gj.z) * d.z;
                         diff = diff - vol_j * (dr + dr + gd) * f;
@@ -164,5 +172,5 @@ fn continuity_update(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     if (is_wall(ph)) { return; }
     let r = rho[i] + sim.dt * continuity[i].x;
     rho[i] = r;
-    press[i] = continuity_eos(ph, r);
+    press[i] = continuity_eos(ph, r, particle_rho0(ph, i));
 }

@@ -108,7 +108,7 @@ fn laser_source(i: u32) -> f32 {
 fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i >= active_particles()) { return; }
-    if (!conducts(phase[i])) { return; }
+    if (!conducts(phase[i]) || programmed(phase[i])) { return; }
     let rate = conduction_rate(i, laser_source(i));
     // Neighbours read only T (.y), so the enthalpy can be updated in place.
     var hv = heat[i];
@@ -280,6 +280,17 @@ fn temperature_of(ph: u32, h: f32) -> vec2<f32> {
     return vec2<f32>(t_s + x, x / (t_l - t_s));
 }
 
+// A PHASE_PROGRAM phase's temperature at time t. Twin of
+// Params::programmed_temperature.
+fn programmed_temperature(ph: u32, time: f32) -> f32 {
+    let cycle = pm_sin_cycles(P.phases[ph].program_frequency * time);
+    return P.phases[ph].program_temperature + P.phases[ph].program_amplitude * cycle + P.phases[ph].program_rate * min(time, P.phases[ph].program_until);
+}
+
+fn programmed(ph: u32) -> bool {
+    return (heat_flags(ph) & PHASE_PROGRAM) != 0u;
+}
+
 @compute @workgroup_size(64)
 fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -288,6 +299,12 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (!conducts(ph)) { return; }
     let flags = heat_flags(ph);
     var hv = heat[i];
+    // A programmed particle: the enthalpy of its temperature at the step's
+    // end (twin of impose_program in src/backend/cpu/heat.rs).
+    if (programmed(ph)) {
+        let t = programmed_temperature(ph, sim.time + sim.dt);
+        hv[H_ENTHALPY] = P.phases[ph].heat_capacity * (t - P.phases[ph].reference_temperature);
+    }
     let tf = temperature_of(ph, hv[H_ENTHALPY]);
     hv[H_TEMPERATURE] = tf.x;
     hv[H_LIQUID] = tf.y;

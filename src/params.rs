@@ -66,6 +66,10 @@ pub const PHASE_FREE_SLIP: u32 = 1 << 12;
 pub const PHASE_MOVES: u32 = 1 << 13;
 /// A liquid phase that takes the F22 (30) recoil pressure at its surface.
 pub const PHASE_RECOIL: u32 = 1 << 14;
+/// A fluid phase whose reference density follows the temperature (δ-SPH).
+pub const PHASE_DENSITY_LAW: u32 = 1 << 15;
+/// A phase whose temperature follows its program instead of the heat equation.
+pub const PHASE_PROGRAM: u32 = 1 << 16;
 
 /// `Laser::model` codes (0: no laser).
 pub const LASER_BEER_LAMBERT: u32 = 1;
@@ -308,6 +312,27 @@ gpu_struct! {
         /// fixed temperature is its own, in heat.x.)
         pub contact_cos: f32,
         pub contact_sin: f32,
+        /// Thermal expansion (PHASE_DENSITY_LAW, δ-SPH): the density law's
+        /// point count; point k is density[k / 4]'s component k % 4.
+        pub density_points: u32,
+        /// PHASE_PROGRAM: T(t) = reference + A sin(2π f t) + Ṫ min(t, t_end),
+        /// the reference being the phase's initial temperature.
+        pub program_temperature: f32,
+        pub program_amplitude: f32,
+        pub program_frequency: f32,
+        pub program_rate: f32,
+        pub program_until: f32,
+        pub density: [DensityPoints; 2],
+    }
+}
+
+gpu_struct! {
+    /// Four points of a phase's density law ρ0(T) (model::expansion::DensityLaw):
+    /// ρ0 = value[k] + slope[k] (T − temperature[k]) from point k to the next.
+    pub struct DensityPoints {
+        pub temperature: glam::Vec4,
+        pub value: glam::Vec4,
+        pub slope: glam::Vec4,
     }
 }
 
@@ -385,6 +410,14 @@ gpu_struct! {
         /// The rigid bodies' Jacobi rotations leave an off-diagonal entry at or
         /// below this fraction of its diagonal pair (f32 rounding).
         pub jacobi_floor: f32,
+        /// Portable sin (portable_math::sin_cycles): 2π and the odd Taylor
+        /// coefficients −1/3!, 1/5!, …, −1/11!.
+        pub two_pi: f32,
+        pub sin_c0: f32,
+        pub sin_c1: f32,
+        pub sin_c2: f32,
+        pub sin_c3: f32,
+        pub sin_c4: f32,
     }
 }
 
@@ -452,6 +485,12 @@ pub const SHADER_CONSTS: Consts = {
         four: 4.0,
         tenth: 0.1,
         jacobi_floor: 1e-7,
+        two_pi: std::f32::consts::TAU,
+        sin_c0: pm::SIN_C[0],
+        sin_c1: pm::SIN_C[1],
+        sin_c2: pm::SIN_C[2],
+        sin_c3: pm::SIN_C[3],
+        sin_c4: pm::SIN_C[4],
     }
 };
 
@@ -630,6 +669,38 @@ impl Params {
     }
     pub fn phase(&self, phase: u32) -> &Phase {
         &self.phases[phase as usize]
+    }
+    /// The reference density at temperature t: the density law's ρ0(T)
+    /// (PHASE_DENSITY_LAW), else ρ0. Twin of reference_density in
+    /// shaders/lib/phase.wgsl (same operations).
+    #[inline(always)]
+    pub fn reference_density(&self, phase: u32, t: f32) -> f32 {
+        let p = self.phase(phase);
+        if p.flags & PHASE_DENSITY_LAW == 0 {
+            return p.rho0;
+        }
+        let mut k = 0usize;
+        for i in 1..p.density_points as usize {
+            if t >= p.density[i / 4].temperature[i % 4] {
+                k = i;
+            }
+        }
+        let row = &p.density[k / 4];
+        let c = k % 4;
+        row.value[c] + row.slope[c] * (t - row.temperature[c])
+    }
+    /// The phase's temperature follows its program, not the heat equation.
+    pub fn programmed(&self, phase: u32) -> bool {
+        self.phase(phase).flags & PHASE_PROGRAM != 0
+    }
+    /// A PHASE_PROGRAM phase's temperature at time t. Twin of
+    /// programmed_temperature in shaders/heat.wgsl.
+    pub fn programmed_temperature(&self, phase: u32, time: f32) -> f32 {
+        let p = self.phase(phase);
+        let cycle = crate::portable_math::sin_cycles(p.program_frequency * time);
+        p.program_temperature
+            + p.program_amplitude * cycle
+            + p.program_rate * time.min(p.program_until)
     }
     /// A wall for the fluid passes: wall or solid particles (they do not move).
     pub fn is_wall(&self, phase: u32) -> bool {
@@ -940,6 +1011,24 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
         }
     }
     b.emissivity_sb = (t.emissivity * STEFAN_BOLTZMANN) as f32;
+    if let Some(p) = t.program {
+        b.flags |= PHASE_PROGRAM;
+        b.program_temperature = t.temperature as f32;
+        b.program_amplitude = p.amplitude as f32;
+        b.program_frequency = p.frequency as f32;
+        b.program_rate = p.rate as f32;
+        b.program_until = finite_or_max(p.until);
+    }
+    if let Some(law) = &ph.density_law {
+        b.flags |= PHASE_DENSITY_LAW;
+        b.density_points = law.points.len() as u32;
+        for (k, (&(t, r), s)) in law.points.iter().zip(law.slopes()).enumerate() {
+            let row = &mut b.density[k / 4];
+            row.temperature[k % 4] = t as f32;
+            row.value[k % 4] = r as f32;
+            row.slope[k % 4] = s as f32;
+        }
+    }
     b
 }
 

@@ -24,6 +24,16 @@ pub const EXP_C: [f32; 6] = [
 /// 1/(2k+1) for k = 1..5: ln(1+f) = 2s(1 + s²/3 + s⁴/5 + …), s = f/(2+f), |s| ≤ 0.172.
 pub const LN_C: [f32; 5] = [1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0, 1.0 / 11.0];
 
+/// Odd Taylor coefficients of sin θ, −1/3!, 1/5!, …, −1/11!, on |θ| ≤ π/2
+/// (truncation θ¹³/13! < 6e-8).
+pub const SIN_C: [f32; 5] = [
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+];
+
 const EXP_MAX: f32 = 88.0;
 const EXP_MIN: f32 = -87.3;
 
@@ -103,6 +113,23 @@ mod tests {
         assert_eq!(exp(-100.0), 0.0);
     }
 
+    /// sin(2π x) within 3e-7 absolute over −3..100 cycles, against the f64 sine
+    /// of the same f32 x: the reduction f = x − ⌊x + ½⌋ is exact (Sterbenz), then
+    /// θ = 2π f (½ ULP of 1.6), the truncation (< 6e-8) and Horner (~2 ULP of 1).
+    #[test]
+    fn sin_cycles_accurate() {
+        let mut worst: f64 = 0.0;
+        for k in 0..400_000 {
+            let x = -3.0 + 103.0 * k as f32 / 400_000.0;
+            let exact = (std::f64::consts::TAU * x as f64).sin();
+            worst = worst.max((sin_cycles(x) as f64 - exact).abs());
+        }
+        assert!(worst <= 3e-7, "sin worst {worst}");
+        assert_eq!(sin_cycles(0.0), 0.0);
+        assert!((sin_cycles(0.25) - 1.0).abs() <= 1.2e-7);
+        assert!((sin_cycles(-0.25) + 1.0).abs() <= 1.2e-7);
+    }
+
     /// ln within 2e-7 absolute near 1 and 3 ULP elsewhere, over 1e-37 .. 1e38.
     #[test]
     fn ln_accurate() {
@@ -148,4 +175,22 @@ mod tests {
             "pow exceeds the error-propagation bound by {worst}x"
         );
     }
+}
+
+/// sin(2π x) for x in cycles (a temperature program's phase t/P): x reduced to
+/// f ∈ [−¼, ¼] by sin's period and its symmetry about ¼ cycle, then the
+/// Taylor polynomial of θ = 2π f. Finite x only; |x| up to 2^22 keeps f to
+/// 2^-2 cycles' ULP (a program runs a few hundred cycles).
+pub fn sin_cycles(x: f32) -> f32 {
+    let mut f = x - (x + 0.5).floor();
+    if f > 0.25 {
+        f = 0.5 - f;
+    } else if f < -0.25 {
+        f = -0.5 - f;
+    }
+    let th = f * std::f32::consts::TAU;
+    let z = th * th;
+    let c = &SIN_C;
+    let p = c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * c[4])));
+    th + th * (z * p)
 }

@@ -467,6 +467,15 @@ pub struct Material {
     /// is divided by 1 + Δt C (1 − f_l) each step, so the melt stiffens as it
     /// solidifies.
     pub mushy_damping: Option<f64>,
+    /// The reference density as a function of temperature, ρ0(T) (R18 (3.52),
+    /// §4.4): points [T (K), ρ0 (kg/m³)] in rising temperature, linear between
+    /// them and continued along the first and last segments beyond; a temperature
+    /// given twice is a step (R18's 304 SS law jumps at the solidus). The EOS is
+    /// p = c²(ρ − ρ0(T)) and the density diffusion acts on ρ − ρ0(T), so a heated
+    /// particle expands with mass held exact. `formulation = "delta_wcsph"` only;
+    /// `density` stays the nominal value (sound speed from `reference_pressure`,
+    /// the surface terms' volumes m/ρ0).
+    pub density_law: Option<Vec<Vec<f64>>>,
 }
 
 /// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),
@@ -530,6 +539,27 @@ pub struct PhaseDef {
     /// fraction ≥ ½); it turns back into this solid, frozen in place, when it
     /// solidifies (F22 §3.2 with a fixed substrate).
     pub melts_into: Option<String>,
+    /// A temperature imposed on the phase's particles instead of the heat
+    /// equation: T(t) = temperature + amplitude sin(2π t / period) + rate min(t,
+    /// until) (R18 Test 1's thermal cycle, Test 3's heating ramp). Liquid, gas and
+    /// solid phases without a melting band, explicit heat integration.
+    pub temperature_program: Option<TemperatureProgramDef>,
+}
+
+/// `phases.<name>.temperature_program`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureProgramDef {
+    /// K (default 0); needs `period`.
+    #[serde(default)]
+    pub amplitude: f64,
+    /// s.
+    pub period: Option<f64>,
+    /// K/s (default 0).
+    #[serde(default)]
+    pub rate: f64,
+    /// s: the ramp holds its temperature after this time (default: never).
+    pub until: Option<f64>,
 }
 
 /// `phases.<name>.temperature_wave`.
@@ -654,7 +684,11 @@ pub struct CheckDef {
     pub center: Option<Vec<f64>>,
     pub radius: Option<f64>,
     /// Recoil impulse: area of the hot surface (m², m per metre of depth in 2D).
+    /// Column expansion: the tank's cross-section (its width in 2D).
     pub area: Option<f64>,
+    /// Thermal expansion: the mean volume error allowed in the band
+    /// 0.8 R < r < 0.9 R (default twice `tolerance`, R18's 0.8% against 0.4%).
+    pub band_tolerance: Option<f64>,
     /// Free rotation: the largest relative change of the rotational energy.
     pub energy_tolerance: Option<f64>,
     /// Bed at rest: the time (s) after which no body may move (default: half
@@ -726,6 +760,12 @@ pub enum CheckKind {
     MeltingGrain,
     /// A 2D disc settling midway between two walls reaches Faxén's terminal velocity.
     Settling,
+    /// R18 Test 1: a load-free drop under a thermal cycle takes the volume its
+    /// density law asks for (each particle's m/ρ against m/ρ0(T)).
+    ThermalExpansion,
+    /// R18 Test 3: two fluids in an open tank, the lower one expanding: each
+    /// fluid's height against its true volume over the tank's width (`area`).
+    ColumnExpansion,
 }
 
 impl CheckKind {
@@ -755,6 +795,8 @@ impl CheckKind {
             CheckKind::BedAtRest => "bed_at_rest",
             CheckKind::MeltingGrain => "melting_grain",
             CheckKind::Settling => "settling",
+            CheckKind::ThermalExpansion => "thermal_expansion",
+            CheckKind::ColumnExpansion => "column_expansion",
         }
     }
 }

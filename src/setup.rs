@@ -399,12 +399,18 @@ fn hydrostatic_start(m: &Model, st: &mut State, sites: &[[u32; 3]], axis: usize)
         if !ph.is_fluid() {
             continue;
         }
-        let weight = ph.rho0 * g * m.dx;
+        // The particle's own ρ0 (a density law's at its temperature).
+        let (rho0, mass) = if ph.density_law.is_some() {
+            (st.rho[i] as f64, st.mass[i] as f64)
+        } else {
+            (ph.rho0, ph.mass)
+        };
+        let weight = rho0 * g * m.dx;
         let p = load + 0.5 * weight;
         load += weight;
-        let compression = p / (ph.rho0 * ph.sound_speed * ph.sound_speed);
-        st.mass[i] = (ph.mass * (1.0 + compression)) as f32;
-        st.rho[i] = (ph.rho0 * (1.0 + compression)) as f32;
+        let compression = p / (rho0 * ph.sound_speed * ph.sound_speed);
+        st.mass[i] = (mass * (1.0 + compression)) as f32;
+        st.rho[i] = (rho0 * (1.0 + compression)) as f32;
         st.press[i] = p as f32;
     }
 }
@@ -427,9 +433,18 @@ fn push_particle(m: &Model, st: &mut State, x: [f64; 3], pi: usize) {
     st.vel.push(v);
     st.acc.push([0.0; 4]);
     st.acc_b.push([0.0; 4]);
-    st.rho.push(ph.rho0 as f32);
+    // A density law: the particle starts at rest at its own ρ0(T0), its mass
+    // that density times the lattice volume (δ-SPH, R18 (3.52)).
+    let (rho0, mass) = match (&ph.density_law, ph.thermal) {
+        (Some(law), Some(t)) => {
+            let rho0 = law.at(t.temperature_at(x));
+            (rho0, rho0 * m.dx.powi(m.dim as i32))
+        }
+        _ => (ph.rho0, ph.mass),
+    };
+    st.rho.push(rho0 as f32);
     st.press.push(0.0);
-    st.mass.push(ph.mass as f32);
+    st.mass.push(mass as f32);
     st.phase.push(pi as u32);
     st.id.push(id);
     if m.is_thermal() {

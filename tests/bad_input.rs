@@ -70,7 +70,11 @@ fn formulation_and_heat_integration_keys() {
     let cases: [(&str, &[&str], &str); 5] = [
         (&dam, &["simulation.delta=0.1"], "simulation.delta"),
         (&dam, &[delta, "simulation.delta=1.5"], "simulation.delta"),
-        (&dam, &["simulation.viscosity_form=\"marrone\""], "simulation.viscosity_form"),
+        (
+            &dam,
+            &["simulation.viscosity_form=\"marrone\""],
+            "simulation.viscosity_form",
+        ),
         (&dam, &["heat.integrator=\"trapezoidal\""], "key `heat`"),
         (&heat, &["heat.max_iterations=0"], "heat.max_iterations"),
     ];
@@ -81,11 +85,66 @@ fn formulation_and_heat_integration_keys() {
         }
         common::assert_input_error(&args, key);
     }
-    let out = spatter(&["validate", &common::scene("laplace_free_disc_2d"), "--set", "simulation.pressure_floor=true"]);
+    let out = spatter(&[
+        "validate",
+        &common::scene("laplace_free_disc_2d"),
+        "--set",
+        "simulation.pressure_floor=true",
+    ]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
     assert!(
         format!("{stdout}{stderr}").contains("key `simulation.pressure_floor`"),
         "{stdout}{stderr}"
     );
+}
+
+/// Thermal expansion's keys: a density law needs δ-SPH, a fluid phase with a
+/// temperature, 2..8 points of rising temperature; a temperature program needs
+/// a non-melting phase, an amplitude a period, the explicit heat step.
+#[test]
+fn density_law_and_temperature_program_keys() {
+    let drop = common::scene("thermal_cycle_drop_2d");
+    let column = common::scene("column_expansion_2d");
+    let law = "materials.fluid.density_law";
+    let cases: [(&str, &[&str], &str); 7] = [
+        (&drop, &["simulation.formulation=\"wcsph\""], law),
+        (
+            &drop,
+            &["materials.fluid.density_law=[[300.0, 1000.0]]"],
+            law,
+        ),
+        (
+            &drop,
+            &["materials.fluid.density_law=[[300.0, 1000.0], [250.0, 950.0]]"],
+            law,
+        ),
+        (
+            &drop,
+            &["materials.fluid.density_law=[[300.0, -1.0], [350.0, 950.0]]"],
+            law,
+        ),
+        (
+            &drop,
+            &["phases.fluid.temperature_program={ amplitude = 50.0 }"],
+            "phases.fluid.temperature_program.period",
+        ),
+        (
+            &drop,
+            &["heat.integrator=\"trapezoidal\""],
+            "phases.fluid.temperature_program",
+        ),
+        (
+            &column,
+            &["materials.wall.density_law=[[300.0, 1000.0], [400.0, 900.0]]"],
+            "materials.wall.density_law",
+        ),
+    ];
+    for (scene, sets, key) in cases {
+        let mut args = vec!["validate", scene];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        common::assert_input_error(&args, key);
+    }
 }

@@ -298,6 +298,27 @@ fn delta_sph_with_heat_and_bodies() {
     );
 }
 
+/// Thermal expansion on δ-SPH: a density law ρ0(T) in the EOS and the
+/// diffusion, temperatures imposed by a program (the portable sine of R18
+/// Test 1's cycle, Test 3's ramp beside a walled tank with a hydrostatic start).
+#[test]
+fn thermal_expansion_by_density_law_and_program() {
+    // Three cycles in the 200 steps: the sine through all its quadrants.
+    assert_bit_identical(
+        "thermal_cycle_drop_2d",
+        &["phases.fluid.temperature_program.period=0.025"],
+        200,
+    );
+    assert_bit_identical(
+        "column_expansion_2d",
+        &[
+            "simulation.dx=0.1",
+            "phases.lower.temperature_program.rate=1000.0",
+        ],
+        200,
+    );
+}
+
 /// The hardware comparison (by tolerance, each pass started from the CPU state) run
 /// on the software adapter: loading the CPU state into the device before a pass must
 /// leave nothing behind, so every pass and the free-running step differ by exactly 0.

@@ -154,10 +154,16 @@ fn the_models_holders_are_the_schedules() {
 #[test]
 fn a_formulation_runs_and_holds_only_its_own() {
     use spatter::backend::{Pipeline, Stage};
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/validation/dam_break_2d.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/validation/dam_break_2d.toml"
+    );
     for (sets, delta) in [
         (vec![], false),
-        (vec!["simulation.formulation=\"delta_wcsph\"".to_string()], true),
+        (
+            vec!["simulation.formulation=\"delta_wcsph\"".to_string()],
+            true,
+        ),
     ] {
         let l = spatter::run::load(path, &sets).unwrap();
         let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
@@ -169,6 +175,10 @@ fn a_formulation_runs_and_holds_only_its_own() {
         assert_eq!(!l.state.continuity.is_empty(), delta);
         assert_eq!(!l.state.density_gradient.is_empty(), delta);
         let rho = FIELDS.iter().find(|f| f.binding == "rho").unwrap();
-        assert_eq!(rho.sorted_in(p.held()), delta, "the density is state only on δ-SPH");
+        assert_eq!(
+            rho.sorted_in(p.held()),
+            delta,
+            "the density is state only on δ-SPH"
+        );
     }
 }

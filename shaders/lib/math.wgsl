@@ -54,3 +54,17 @@ fn pm_ln(x: f32) -> f32 {
 fn pm_pow(x: f32, y: f32) -> f32 {
     return pm_exp(y * pm_ln(x));
 }
+
+// sin(2 pi x), x in cycles. Twin of portable_math::sin_cycles.
+fn pm_sin_cycles(x: f32) -> f32 {
+    var f = x - floor(x + c_half());
+    if (f > 0.25) {
+        f = c_half() - f;
+    } else if (f < -0.25) {
+        f = -c_half() - f;
+    }
+    let th = f * P.consts.two_pi;
+    let z = th * th;
+    let p = P.consts.sin_c0 + z * (P.consts.sin_c1 + z * (P.consts.sin_c2 + z * (P.consts.sin_c3 + z * P.consts.sin_c4)));
+    return th + th * (z * p);
+}

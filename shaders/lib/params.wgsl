@@ -142,6 +142,21 @@ struct Phase {
     contact_cos: f32,        // F22 (27): cos, sin of the liquid's contact angle on
     contact_sin: f32,        // this wall/solid phase (FLAG_WETTING); a Dirichlet
                              // wall's temperature is per particle (heat.x)
+    density_points: u32,     // PHASE_DENSITY_LAW: point k is density[k / 4][k % 4]
+    program_temperature: f32, // PHASE_PROGRAM: T = this + A sin(2 pi f t) + rate min(t, until)
+    program_amplitude: f32,
+    program_frequency: f32,
+    program_rate: f32,
+    program_until: f32,
+    density: array<DensityPoints, 2>,
+}
+
+// Four points of a density law rho0(T): rho0 = value + slope (T - temperature)
+// from a point to the next (model::expansion::DensityLaw).
+struct DensityPoints {
+    temperature: vec4<f32>,
+    value: vec4<f32>,
+    slope: vec4<f32>,
 }
 
 // Arithmetic literals (see consts.wgsl).
@@ -176,6 +191,12 @@ struct Consts {
     four: f32,
     tenth: f32,
     jacobi_floor: f32,
+    two_pi: f32,
+    sin_c0: f32,
+    sin_c1: f32,
+    sin_c2: f32,
+    sin_c3: f32,
+    sin_c4: f32,
 }
 
 // Offsets, sizes and strides follow WGSL's layout rules (encase computes the same
@@ -258,6 +279,8 @@ const HEAT_SWITCH_SHIFT: u32 = 8u;
 const PHASE_FREE_SLIP: u32 = 4096u;
 const PHASE_MOVES: u32 = 8192u;
 const PHASE_RECOIL: u32 = 16384u;
+const PHASE_DENSITY_LAW: u32 = 32768u;
+const PHASE_PROGRAM: u32 = 65536u;
 const LASER_BEER_LAMBERT: u32 = 1u;
 const LASER_SURFACE: u32 = 2u;
 const HEAT_EULER: u32 = 0u;

@@ -19,3 +19,22 @@ fn conducts(ph: u32) -> bool {
 fn heat_flags(ph: u32) -> u32 {
     return P.phases[ph].flags;
 }
+
+// The reference density at temperature t: the phase's density law rho0(T)
+// (PHASE_DENSITY_LAW, δ-SPH thermal expansion, R18 (3.52)), else rho0. Twin of
+// Params::reference_density.
+fn reference_density(ph: u32, t: f32) -> f32 {
+    if ((P.phases[ph].flags & PHASE_DENSITY_LAW) == 0u) {
+        return P.phases[ph].rho0;
+    }
+    var k = 0u;
+    for (var i = 1u; i < P.phases[ph].density_points; i = i + 1u) {
+        if (t >= P.phases[ph].density[i / 4u].temperature[i % 4u]) {
+            k = i;
+        }
+    }
+    let c = k % 4u;
+    let row = k / 4u;
+    let t_k = P.phases[ph].density[row].temperature[c];
+    return P.phases[ph].density[row].value[c] + P.phases[ph].density[row].slope[c] * (t - t_k);
+}

@@ -35,6 +35,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/adiabatic_box"), &[]),
     (scene_file!("validation/conduction_1d"), &[]),
     (scene_file!("validation/collision_2d"), &[]),
+    (scene_file!("validation/column_expansion_2d"), &["dx=0.1"]),
     (scene_file!("validation/conduction_two_materials"), &[]),
     (
         scene_file!("validation/couette_2d"),
@@ -70,6 +71,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/settling_disc_2d"), &["dx=0.02"]),
     (scene_file!("validation/square_drop_2d"), &["dx=4e-3"]),
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),
+    (scene_file!("validation/thermal_cycle_drop_2d"), &["dx=0.1"]),
     (scene_file!("validation/thermocapillary_2d"), &[]),
     (scene_file!("validation/two_layer_2d"), &["dx=0.01"]),
     (

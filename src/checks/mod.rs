@@ -7,11 +7,13 @@
 //! (conduction, two materials, adiabatic box, Stefan, Rosenthal, laser energy),
 //! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
-//! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain).
+//! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
+//! expansion.rs (δ-SPH thermal expansion: R18 Tests 1 and 3).
 
 mod bodies;
 mod compression;
 mod dam_break;
+mod expansion;
 mod flow;
 mod heat;
 mod tension;
@@ -146,6 +148,14 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::BedAtRest => Box::new(bodies::AtRest::new(c.settle_time)),
         CheckKind::MeltingGrain => Box::new(bodies::MeltingGrain::default()),
         CheckKind::Settling => Box::new(bodies::Settling::new(c.settle_time)),
+        CheckKind::ThermalExpansion => Box::new(expansion::ThermalExpansion::new(
+            c.settle_time,
+            c.band_tolerance,
+            c.tolerance,
+        )),
+        CheckKind::ColumnExpansion => {
+            Box::new(expansion::ColumnExpansion::new(c.area.unwrap_or(f64::NAN)))
+        }
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

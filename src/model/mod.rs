@@ -3,6 +3,7 @@
 
 mod bodies;
 mod domain;
+pub mod expansion;
 mod laser;
 pub mod limits;
 mod phases;
@@ -495,8 +496,23 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     };
     if let Some(c) = &scene.check {
         cx.positive("check.tolerance", c.tolerance)?;
-        if c.kind == crate::scene::CheckKind::RecoilImpulse {
+        if c.kind == crate::scene::CheckKind::RecoilImpulse
+            || c.kind == crate::scene::CheckKind::ColumnExpansion
+        {
             cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
+        }
+        if let Some(b) = c.band_tolerance {
+            cx.positive("check.band_tolerance", b)?;
+        }
+        if matches!(
+            c.kind,
+            crate::scene::CheckKind::ThermalExpansion | crate::scene::CheckKind::ColumnExpansion
+        ) && !phases.iter().any(|p| p.density_law.is_some())
+        {
+            return Err(cx.err(
+                "check.kind",
+                "the expansion checks need a liquid with a density law (materials.<m>.density_law)",
+            ));
         }
         if c.kind == crate::scene::CheckKind::DropShape
             && (dim != 2 || !surface_tension.as_ref().is_some_and(|s| s.slope == 0.0))

@@ -21,6 +21,8 @@ pub struct PhaseInfo {
     /// Phase change: the phase a solid becomes when it melts, or a liquid when it
     /// solidifies.
     pub switch_to: Option<usize>,
+    /// ρ0(T) (`materials.<m>.density_law`, δ-SPH): `rho0` is then the nominal value.
+    pub density_law: Option<super::expansion::DensityLaw>,
 }
 
 /// Heat properties of a phase (heat scenes only).
@@ -41,6 +43,8 @@ pub struct Thermal {
     pub mushy_damping: f64,
     /// `temperature_wave`: T(x) = temperature + amplitude cos(2π x_axis / wavelength).
     pub wave: Option<TemperatureWave>,
+    /// `temperature_program`: T(t) imposed instead of the heat equation.
+    pub program: Option<super::expansion::TemperatureProgram>,
 }
 
 /// A cosine temperature along one axis (`phases.<name>.temperature_wave`).
@@ -117,6 +121,10 @@ impl Thermal {
 }
 
 impl PhaseInfo {
+    /// The reference density at temperature t: the density law's, else ρ0.
+    pub fn rho0_at(&self, t: f64) -> f64 {
+        self.density_law.as_ref().map_or(self.rho0, |l| l.at(t))
+    }
     /// The evaporation law of a liquid phase that takes the F22 (30) recoil.
     pub fn recoil(&self) -> Option<Evaporation> {
         self.thermal
@@ -199,10 +207,12 @@ pub(super) fn phase_table(
             mass: rho0 * dx.powi(dim as i32),
             thermal: None,
             switch_to: None,
+            density_law: None,
         });
     }
     thermal_table(cx, scene, &mut out)?;
     phase_changes(cx, scene, &mut out)?;
+    super::expansion::expansion_table(cx, scene, &mut out)?;
     Ok(out)
 }
 

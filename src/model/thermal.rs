@@ -68,6 +68,7 @@ pub(super) fn thermal_table(
                 emissivity: 0.0,
                 mushy_damping: 0.0,
                 wave,
+                program: None,
             });
             continue;
         }
@@ -159,6 +160,7 @@ pub(super) fn thermal_table(
             emissivity,
             mushy_damping,
             wave,
+            program: None,
         });
     }
     Ok(())

@@ -33,14 +33,24 @@
 //! every other pass (bodies, heat, the transport velocity) stay as it is.
 
 use super::bodies::point_velocity;
-use super::density::equation_of_state;
 use super::neighbors::{
     for_each_neighbor, min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
 use crate::kernel;
-use crate::params::{Params, FLAG_BODIES};
-use crate::state::{State, NO_BODY};
+use crate::params::{Params, FLAG_BODIES, FLAG_PRESSURE_FLOOR, PHASE_DENSITY_LAW};
+use crate::state::{State, H_TEMPERATURE, NO_BODY};
 use rayon::prelude::*;
+
+/// Particle i's reference density: its phase's density law at its temperature
+/// (the previous step's: the heat passes run after this one), else ρ0. R18
+/// (3.52)–(3.53): the EOS and the diffusion act on ρ − ρ0(T).
+#[inline(always)]
+fn particle_rho0(pr: &Params, heat: &[[f32; 4]], ph: u32, i: usize) -> f32 {
+    if pr.phase(ph).flags & PHASE_DENSITY_LAW != 0 {
+        return pr.reference_density(ph, heat[i][H_TEMPERATURE]);
+    }
+    pr.phase(ph).rho0
+}
 
 /// The real velocity of wall or body particle j (not the wall pass's ghost).
 #[inline(always)]
@@ -71,8 +81,7 @@ pub fn gradients(pr: &Params, st: &mut State, grid: &CellTable) {
             if pr.is_wall(ph_i) {
                 return [0.0; 4];
             }
-            let rho0_i = pr.phase(ph_i).rho0;
-            let excess_i = s.rho[i] - rho0_i;
+            let excess_i = s.rho[i] - particle_rho0(pr, &s.heat, ph_i, i);
             let (mut m, mut b) = ([0.0f32; 6], [0.0f32; 3]);
             for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
                 if r2 <= 0.0 || s.phase[j] != ph_i {
@@ -86,7 +95,7 @@ pub fn gradients(pr: &Params, st: &mut State, grid: &CellTable) {
                 m[3] -= vf * d[1] * d[1];
                 m[4] -= vf * d[1] * d[2];
                 m[5] -= vf * d[2] * d[2];
-                let db = (s.rho[j] - rho0_i - excess_i) * vf;
+                let db = (s.rho[j] - particle_rho0(pr, &s.heat, ph_i, j) - excess_i) * vf;
                 for a in 0..3 {
                     b[a] += db * d[a];
                 }
@@ -131,7 +140,8 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
     let ph_i = st.phase[i];
     let mat_i = pr.phase(ph_i);
     let (rho_i, m_i) = (st.rho[i], st.mass[i]);
-    let excess_i = rho_i - mat_i.rho0;
+    let rho0_i = particle_rho0(pr, &st.heat, ph_i, i);
+    let excess_i = rho_i - rho0_i;
     let g_i = st.density_gradient[i];
     let v_i = st.vel[i];
     let pi = st.pos[i];
@@ -143,7 +153,7 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
         let r = r2.sqrt();
         let ph_j = st.phase[j];
         if pr.is_wall(ph_j) {
-            let rho_w = mat_i.rho0 + st.press[j] / mat_i.c2;
+            let rho_w = rho0_i + st.press[j] / mat_i.c2;
             let vol_w = m_i / rho_w;
             gamma += vol_w * kernel::w(pr, r);
             if r2 > 0.0 {
@@ -162,7 +172,7 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
                     (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
                 div += vol_j * ud * f;
                 if ph_j == ph_i {
-                    let dr = rho_j - mat_i.rho0 - excess_i;
+                    let dr = rho_j - particle_rho0(pr, &st.heat, ph_i, j) - excess_i;
                     let g_j = st.density_gradient[j];
                     let gd = (g_i[0] + g_j[0]) * d[0]
                         + (g_i[1] + g_j[1]) * d[1]
@@ -206,11 +216,12 @@ pub fn rates(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborL
     list.store(grid, chunks);
 }
 
-/// `continuity_update`: ρ += Δt dρ/dt and the EOS, fluid particles.
+/// `continuity_update`: ρ += Δt dρ/dt and the EOS p = c²(ρ − ρ0(T)), fluid
+/// particles.
 pub fn update(pr: &Params, st: &mut State) {
     let n = st.active();
     let dt = st.sim.dt;
-    let (phase, rates) = (&st.phase, &st.continuity);
+    let (phase, rates, heat) = (&st.phase, &st.continuity, &st.heat);
     st.rho[..n]
         .par_iter_mut()
         .zip(st.press[..n].par_iter_mut())
@@ -222,6 +233,17 @@ pub fn update(pr: &Params, st: &mut State) {
             }
             let r = *rho + dt * rates[i][0];
             *rho = r;
-            *p = equation_of_state(pr, ph, r);
+            *p = continuity_eos(pr, ph, r, particle_rho0(pr, heat, ph, i));
         });
+}
+
+/// The density pass's EOS with the particle's own reference density.
+#[inline(always)]
+fn continuity_eos(pr: &Params, ph: u32, rho: f32, rho0: f32) -> f32 {
+    let p = pr.phase(ph).c2 * (rho - rho0);
+    if pr.flag(FLAG_PRESSURE_FLOOR) {
+        p.max(0.0)
+    } else {
+        p
+    }
 }

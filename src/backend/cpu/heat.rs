@@ -130,7 +130,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
     let rates: Vec<f32> = (0..s.active())
         .into_par_iter()
         .map(|i| {
-            if !pr.conducts(s.phase[i]) {
+            if !pr.conducts(s.phase[i]) || pr.programmed(s.phase[i]) {
                 return 0.0;
             }
             rate(
@@ -148,7 +148,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
         .zip(rates)
         .enumerate()
         .for_each(|(i, (hv, rate))| {
-            if pr.conducts(phase[i]) {
+            if pr.conducts(phase[i]) && !pr.programmed(phase[i]) {
                 hv[H_ENTHALPY] += dt * rate;
                 hv[H_RATE] = rate;
             }
@@ -347,12 +347,22 @@ pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
 
 /// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a
 /// solid whose liquid fraction reaches ½ becomes its liquid phase (at rest), a
+/// A PHASE_PROGRAM particle (no melting band): the enthalpy of its programmed
+/// temperature at the end of the step, h = c (T(t) − T_ref); T and f_l follow
+/// from it as for every particle (T to within an ULP of the program).
+fn impose_program(pr: &Params, ph: u32, now: f32, hv: &mut [f32; 4]) {
+    let p = pr.phase(ph);
+    let t = pr.programmed_temperature(ph, now);
+    hv[H_ENTHALPY] = p.heat_capacity * (t - p.reference_temperature);
+}
+
 /// liquid whose liquid fraction falls below ½ becomes its solid phase, frozen in
 /// place (velocity and accelerations zeroed). With rigid bodies, a particle that
 /// solidified is marked `BODY_SOLIDIFIED` for `bodies.melt`, which bonds the
 /// bodies it touches.
 pub fn temperature(pr: &Params, st: &mut State) {
     let n = st.active();
+    let now = st.sim.time + st.sim.dt;
     let State {
         heat,
         phase,
@@ -376,6 +386,9 @@ pub fn temperature(pr: &Params, st: &mut State) {
         .filter_map(|(i, ((hv, ph), (v, (a, ab))))| {
             if !pr.conducts(*ph) {
                 return None;
+            }
+            if pr.programmed(*ph) {
+                impose_program(pr, *ph, now, hv);
             }
             let (t, fl) = temperature_of(pr, *ph, hv[H_ENTHALPY]);
             hv[H_TEMPERATURE] = t;

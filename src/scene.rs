@@ -210,9 +210,9 @@ pub struct PowderDef {
     /// until the box is full, levelled at its top.
     pub max_grains: Option<usize>,
     /// Each grain is a rigid body (F22 §2.2): it moves under gravity, contact
-    /// ([contact] is required) and the fluid's forces. The grains' phase must
-    /// not melt (melting bodies are not built yet). Default: grains fixed in
-    /// place.
+    /// ([contact] is required) and the fluid's forces. A grain phase that melts
+    /// (`melts_into`) loses its molten members to the melt and bonds where its
+    /// melt solidifies (F22 §3.2). Default: grains fixed in place.
     #[serde(default)]
     pub rigid: bool,
 }

@@ -103,17 +103,30 @@ fn surface_tension(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     acc[i] = a;
 }
 
+// (alpha, d alpha / dT) at t_i: F22 (8) plus R18 (4.2)'s solute term (Sahoo)
+// when sahoo_r_gamma > 0, clipped at alpha_min. Twin of Params::tension_law.
+fn tension_law(t_i: f32) -> vec2<f32> {
+    var alpha = P.tension.alpha0 + P.tension.alpha_slope * (t_i - P.tension.t_ref);
+    var slope = P.tension.alpha_slope;
+    if (P.tension.sahoo_r_gamma > 0.0) {
+        let ka = P.tension.sahoo_k_a * pm_exp(P.tension.sahoo_q / t_i);
+        let l = pm_ln(c_one() + ka);
+        alpha = alpha - P.tension.sahoo_r_gamma * t_i * l;
+        slope = slope - P.tension.sahoo_r_gamma * l - P.tension.sahoo_gamma_h * ka / (t_i * (c_one() + ka));
+    }
+    if (alpha <= P.tension.alpha_min) {
+        return vec2<f32>(P.tension.alpha_min, 0.0);
+    }
+    return vec2<f32>(alpha, slope);
+}
+
 // F22 (24) per unit mass on a liquid particle with normal and delta s_i,
 // temperature t_i, curvature kappa and temperature gradient gt:
 // f[T_i] delta (alpha' grad_t T - alpha kappa n) / rho, F22 (8) (alpha' = 0 where clipped).
 fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32) -> vec3<f32> {
-    let raw = P.tension.alpha0 + P.tension.alpha_slope * (t_i - P.tension.t_ref);
-    var alpha = raw;
-    var slope = P.tension.alpha_slope;
-    if (raw <= P.tension.alpha_min) {
-        alpha = P.tension.alpha_min;
-        slope = 0.0;
-    }
+    let law = tension_law(t_i);
+    let alpha = law.x;
+    let slope = law.y;
     let delta = s_i[S_DELTA];
     let nt = s_i.x * gt.x + s_i.y * gt.y + s_i.z * gt.z;
     let tx = gt.x - nt * s_i.x;

@@ -192,6 +192,12 @@ gpu_struct! {
         pub gas: u32,
         /// Free-surface form: |κ| ≤ 1/support (R18's cap 1/(2h) of Wendland); 0 otherwise.
         pub kappa_max: f32,
+        /// R18 (4.2)'s solute term (model::tension::Sahoo; all 0 without it):
+        /// RΓ, k_l a_s, −ΔH0/R, ΓΔH0.
+        pub sahoo_r_gamma: f32,
+        pub sahoo_k_a: f32,
+        pub sahoo_q: f32,
+        pub sahoo_gamma_h: f32,
     }
 }
 
@@ -624,6 +630,12 @@ impl Params {
             t.alpha_slope = s.slope as f32;
             t.t_ref = s.reference_temperature as f32;
             t.alpha_min = s.minimum as f32;
+            if let Some(sh) = s.sahoo {
+                t.sahoo_r_gamma = sh.r_gamma as f32;
+                t.sahoo_k_a = sh.k_a as f32;
+                t.sahoo_q = sh.q as f32;
+                t.sahoo_gamma_h = sh.gamma_h as f32;
+            }
             if let Some((t_m, width)) = s.ramp {
                 t.t_melt = t_m as f32;
                 t.inv_ramp_width = (1.0 / width) as f32;
@@ -701,6 +713,27 @@ impl Params {
         p.program_temperature
             + p.program_amplitude * cycle
             + p.program_rate * time.min(p.program_until)
+    }
+    /// (α, dα/dT) of the surface-tension law at T: F22 (8) plus R18 (4.2)'s
+    /// solute term (when `sahoo_r_gamma` > 0), clipped at α_min. Twin of
+    /// tension_law in shaders/surface_forces.wgsl (portable exp and ln).
+    #[inline(always)]
+    pub fn tension_law(&self, t_i: f32) -> (f32, f32) {
+        use crate::portable_math as pm;
+        let t = &self.tension;
+        let mut alpha = t.alpha0 + t.alpha_slope * (t_i - t.t_ref);
+        let mut slope = t.alpha_slope;
+        if t.sahoo_r_gamma > 0.0 {
+            let ka = t.sahoo_k_a * pm::exp(t.sahoo_q / t_i);
+            let l = pm::ln(1.0 + ka);
+            alpha = alpha - t.sahoo_r_gamma * t_i * l;
+            slope = slope - t.sahoo_r_gamma * l - t.sahoo_gamma_h * ka / (t_i * (1.0 + ka));
+        }
+        if alpha <= t.alpha_min {
+            (t.alpha_min, 0.0)
+        } else {
+            (alpha, slope)
+        }
     }
     /// A wall for the fluid passes: wall or solid particles (they do not move).
     pub fn is_wall(&self, phase: u32) -> bool {

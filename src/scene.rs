@@ -261,6 +261,10 @@ pub struct SurfaceTensionDef {
     /// α_min (N/m): α is clipped there, and α' is 0 where it is. Default 0.
     #[serde(default)]
     pub minimum: f64,
+    /// R18 (4.2): Sahoo et al.'s sulphur term on top of the linear law, σ(T) =
+    /// coefficient + temperature_coefficient (T − reference_temperature)
+    /// − R T Γ_s ln(1 + k_l a_s e^{−ΔH0/(R T)}), with its analytic dσ/dT.
+    pub sahoo: Option<SahooDef>,
     /// ΔT_s (K), F22 (21): in heat scenes whose liquid melts, the force and each
     /// curvature neighbour ramp from 0 at the solidus to 1 at solidus + ΔT_s.
     pub melting_width: Option<f64>,
@@ -269,6 +273,23 @@ pub struct SurfaceTensionDef {
     /// One number for all of them, or a table naming every wall and solid phase
     /// (`{ substrate = 60.0, wall = 90.0 }`). Absent: no wetting model.
     pub contact_angle: Option<ContactAngleDef>,
+}
+
+/// `surface_tension.sahoo`: the surface-active solute's term of R18 (4.2)
+/// (Sahoo, DebRoy & McNallan 1988). R18 prints Γ_s = 1.3e-8 without its unit:
+/// Sahoo's is kmol/m², and only that reading makes dσ/dT change sign (near
+/// 1713 K for 304 SS at a_s = 0.0022 wt%); read as mol/m² the term is 1e-4 N/m.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SahooDef {
+    /// Γ_s, the surface excess at saturation, in kmol/m² (Sahoo's unit).
+    pub surface_excess: f64,
+    /// k_l, the entropy factor of segregation (R18: 0.0032).
+    pub segregation_constant: f64,
+    /// a_s, the solute's activity in wt% (R18: sulphur, 0.0022).
+    pub activity: f64,
+    /// ΔH0, the standard heat of adsorption in J/mol (R18: −1.66e5).
+    pub adsorption_enthalpy: f64,
 }
 
 /// `surface_tension.contact_angle`: one angle, or one per wall and solid phase.

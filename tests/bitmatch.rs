@@ -319,6 +319,25 @@ fn thermal_expansion_by_density_law_and_program() {
     );
 }
 
+/// R18 (4.2)'s Sahoo law (portable exp and ln inside the surface force) on the
+/// README's line melt (δ-SPH, free-surface tension, Marangoni), its plate
+/// started near the solidus so the melt and its tension appear within the steps.
+#[test]
+fn sahoo_surface_tension_on_the_line_melt() {
+    assert_bit_identical_at(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/pbf/line_melt_coarse_2d.toml"
+        ),
+        &[
+            "surface_tension.sahoo={ surface_excess = 1.3e-8, segregation_constant = 0.0032, activity = 0.0022, adsorption_enthalpy = -1.66e5 }",
+            "phases.plate.temperature=1650.0",
+            "laser.power=[[0.0, 4.0e6]]",
+        ],
+        150,
+    );
+}
+
 /// The hardware comparison (by tolerance, each pass started from the CPU state) run
 /// on the software adapter: loading the CPU state into the device before a pass must
 /// leave nothing behind, so every pass and the free-running step differ by exactly 0.

@@ -60,6 +60,10 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     liquid: u32,
     gas: u32,                // NO_PHASE in the free-surface form
     kappa_max: f32,          // free-surface form: |kappa| <= 1/support
+    sahoo_r_gamma: f32,      // R18 (4.2): R Gamma_s (0: no solute term)
+    sahoo_k_a: f32,          // k_l a_s
+    sahoo_q: f32,            // -dH0 / R
+    sahoo_gamma_h: f32,      // Gamma_s dH0
 }
 
 struct Surfaces {

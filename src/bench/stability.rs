@@ -52,6 +52,10 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/jet_outflow_2d"), &[]),
     (scene_file!("validation/laplace_disc_2d"), &["dx=2e-3"]),
     (scene_file!("validation/laplace_free_disc_2d"), &["dx=2e-3"]),
+    (
+        scene_file!("validation/laplace_free_sphere_3d"),
+        &["dx=4e-3"],
+    ),
     (scene_file!("validation/laplace_sphere_3d"), &["dx=4e-3"]),
     (scene_file!("validation/laser_flat_plate"), &["dx=2e-5"]),
     (

@@ -515,7 +515,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             ));
         }
         if c.kind == crate::scene::CheckKind::DropShape
-            && (dim != 2 || !surface_tension.as_ref().is_some_and(|s| s.slope == 0.0))
+            && (dim != 2 || !surface_tension.as_ref().is_some_and(|s| s.is_constant()))
         {
             return Err(cx.err(
                 "check.kind",
@@ -539,7 +539,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
-            if !surface_tension.as_ref().is_some_and(|s| s.slope == 0.0) {
+            if !surface_tension.as_ref().is_some_and(|s| s.is_constant()) {
                 return Err(cx.err(
                     "check.kind",
                     "\"laplace\" needs [surface_tension] with a constant coefficient",
@@ -776,7 +776,7 @@ fn thermocapillary_layout(
     {
         return bad("a 2D scene periodic in x with walls on y");
     }
-    if !tension.is_some_and(|t| t.gas.is_some() && t.slope < 0.0) {
+    if !tension.is_some_and(|t| t.gas.is_some() && t.slope < 0.0 && t.sahoo.is_none()) {
         return bad("[surface_tension] with a gas phase and a negative temperature_coefficient");
     }
     let walls: Vec<&Thermal> = phases

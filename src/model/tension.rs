@@ -19,18 +19,78 @@ pub struct SurfaceTension {
     /// (T_m, ΔT_s): the liquid's solidus and the ramp width above it, in heat
     /// scenes whose liquid melts; None: no regularisation (f = 1).
     pub ramp: Option<(f64, f64)>,
+    /// R18 (4.2)'s solute term (`sahoo`): None for F22's linear law alone.
+    pub sahoo: Option<Sahoo>,
     /// F22 (27)–(29) static contact angle (radians) per phase: Some for every
     /// wall and solid phase when the scene has wetting, None for the others.
     pub contact_angle: Option<Vec<Option<f64>>>,
 }
 
+/// R's gas constant, J/(mol K).
+pub const GAS_CONSTANT: f64 = 8.314_462_618;
+
+/// R18 (4.2)'s solute term − R T Γ ln(1 + K a), K = k_l e^{−ΔH0/(R T)}, in the
+/// constants the device evaluates: RΓ (J/(m² K)), k_l a_s, q = −ΔH0/R (K) and
+/// ΓΔH0 (J/m²), Γ in mol/m².
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sahoo {
+    pub r_gamma: f64,
+    pub k_a: f64,
+    pub q: f64,
+    pub gamma_h: f64,
+}
+
+impl Sahoo {
+    pub fn of(d: &crate::scene::SahooDef) -> Sahoo {
+        let gamma = d.surface_excess * 1e3; // kmol/m² → mol/m²
+        Sahoo {
+            r_gamma: GAS_CONSTANT * gamma,
+            k_a: d.segregation_constant * d.activity,
+            q: -d.adsorption_enthalpy / GAS_CONSTANT,
+            gamma_h: gamma * d.adsorption_enthalpy,
+        }
+    }
+    /// (the term, its T-derivative) at T: −RΓT ln(1 + Ka) and
+    /// −RΓ ln(1 + Ka) − ΓΔH0 Ka/(T (1 + Ka)).
+    pub fn term(&self, t: f64) -> (f64, f64) {
+        let ka = self.k_a * (self.q / t).exp();
+        let l = (1.0 + ka).ln();
+        (
+            -self.r_gamma * t * l,
+            -self.r_gamma * l - self.gamma_h * ka / (t * (1.0 + ka)),
+        )
+    }
+}
+
 impl SurfaceTension {
+    /// (α, dα/dT) at T: F22 (8)'s linear law plus R18 (4.2)'s solute term,
+    /// clipped at α_min (where dα/dT is 0).
+    pub fn law(&self, t: f64) -> (f64, f64) {
+        let mut alpha = self.coefficient + self.slope * (t - self.reference_temperature);
+        let mut slope = self.slope;
+        if let Some(s) = self.sahoo {
+            let (a, da) = s.term(t);
+            alpha += a;
+            slope += da;
+        }
+        if alpha <= self.minimum {
+            (self.minimum, 0.0)
+        } else {
+            (alpha, slope)
+        }
+    }
     pub fn coefficient_at(&self, t: f64) -> f64 {
-        (self.coefficient + self.slope * (t - self.reference_temperature)).max(self.minimum)
+        self.law(t).0
+    }
+    /// α does not depend on the temperature.
+    pub fn is_constant(&self) -> bool {
+        self.slope == 0.0 && self.sahoo.is_none()
     }
     /// The largest α any particle can feel (for the capillary Δt limit): at the
     /// ramp's start when regularised, else at the coldest temperature the scene
-    /// starts with (α falls with T).
+    /// starts with (the linear law falls with T); with the solute term, whose α
+    /// rises up to where dα/dT changes sign, the largest over 1 K steps from
+    /// there to 10^4 K.
     pub fn max_coefficient(&self, phases: &[PhaseInfo]) -> f64 {
         let t_low = match self.ramp {
             Some((t_m, _)) => t_m,
@@ -39,7 +99,13 @@ impl SurfaceTension {
                 .filter_map(|p| p.thermal.map(|t| t.coldest()))
                 .fold(self.reference_temperature, f64::min),
         };
-        self.coefficient_at(t_low)
+        if self.sahoo.is_none() {
+            return self.coefficient_at(t_low);
+        }
+        (0..10_000)
+            .map(|k| t_low.max(1.0) + k as f64)
+            .map(|t| self.coefficient_at(t))
+            .fold(0.0, f64::max)
     }
 }
 
@@ -126,6 +192,31 @@ pub(super) fn surface_tension(
         }
         (None, None) => None,
     };
+    let sahoo = match &d.sahoo {
+        None => None,
+        Some(def) => {
+            let k = |n: &str| format!("surface_tension.sahoo.{n}");
+            cx.positive(&k("surface_excess"), def.surface_excess)?;
+            cx.positive(&k("segregation_constant"), def.segregation_constant)?;
+            cx.positive(&k("activity"), def.activity)?;
+            if !(def.adsorption_enthalpy.is_finite() && def.adsorption_enthalpy < 0.0) {
+                return Err(cx.err(
+                    &k("adsorption_enthalpy"),
+                    format!(
+                        "must be negative (adsorption releases heat; R18: -1.66e5 J/mol), got {}",
+                        def.adsorption_enthalpy
+                    ),
+                ));
+            }
+            if !heat || d.reference_temperature.is_none() {
+                return Err(cx.err(
+                    &k("surface_excess"),
+                    "the solute term needs a heat scene and surface_tension.reference_temperature (T_m of R18 (4.2))",
+                ));
+            }
+            Some(Sahoo::of(def))
+        }
+    };
     let contact_angle = match &d.contact_angle {
         None => None,
         Some(def) => Some(contact_angles(cx, def, phases, gas.is_some())?),
@@ -138,6 +229,7 @@ pub(super) fn surface_tension(
         slope: d.temperature_coefficient,
         reference_temperature,
         minimum,
+        sahoo,
         ramp,
     }))
 }
@@ -198,5 +290,76 @@ fn contact_angles(
                 })
                 .collect()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// R18 (4.2) for 304 SS (σ0 = 1.943 N/m, A = 5e-4 N/(m K), T_m = 1723 K,
+    /// k_l = 0.0032, a_s = 0.0022 wt%, ΔH0 = −1.66e5 J/mol): with Γ_s in kmol/m²
+    /// (Sahoo's unit) σ(T_m) = 1.8379 N/m and dσ/dT changes sign at 1713.06 K
+    /// (positive below: +2.62e-4 at 1600 K; −4.50e-4 at 2200 K), as
+    /// PAPERS-EXTRACT §5.8 derives; read as mol/m² (1.3e-11 kmol/m² here) the
+    /// term is 1e-4 N/m and dσ/dT within 1% of −A everywhere. The derivative is the
+    /// analytic one: it matches a central difference to 1e-9 N/(m K).
+    #[test]
+    fn sahoo_law_changes_sign_near_1713_k_in_kmol() {
+        let law = |gamma_kmol: f64| SurfaceTension {
+            liquid: 0,
+            gas: None,
+            coefficient: 1.943,
+            slope: -0.5e-3,
+            reference_temperature: 1723.0,
+            minimum: 0.0,
+            ramp: None,
+            sahoo: Some(Sahoo::of(&crate::scene::SahooDef {
+                surface_excess: gamma_kmol,
+                segregation_constant: 0.0032,
+                activity: 0.0022,
+                adsorption_enthalpy: -1.66e5,
+            })),
+            contact_angle: None,
+        };
+        let s = law(1.3e-8);
+        assert!(
+            (s.law(1723.0).0 - 1.837_88).abs() < 1e-4,
+            "{:?}",
+            s.law(1723.0)
+        );
+        assert!((s.law(1600.0).1 - 2.62e-4).abs() < 1e-6);
+        assert!((s.law(2200.0).1 + 4.50e-4).abs() < 1e-6);
+        let (mut lo, mut hi) = (1600.0, 1800.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if s.law(mid).1 > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        assert!((lo - 1713.06).abs() < 0.05, "sign change at {lo} K");
+        for t in [1500.0, 1713.0, 1900.0, 2500.0] {
+            let fd = (s.law(t + 1e-3).0 - s.law(t - 1e-3).0) / 2e-3;
+            assert!(
+                (fd - s.law(t).1).abs() < 1e-9,
+                "T = {t}: {fd} vs {}",
+                s.law(t).1
+            );
+        }
+        let mol = law(1.3e-11);
+        // (at 1000 K the term's slope is +1.3e-6, 0.3% of A: no sign change)
+        for t in [1000.0, 1713.0, 3000.0] {
+            assert!(
+                (mol.law(t).1 + 0.5e-3).abs() < 0.01 * 0.5e-3,
+                "mol reading at {t} K"
+            );
+        }
+        // The capillary limit's α: the largest from the coldest temperature on
+        // (here T_α0 = 1723 K, above the peak, where α falls).
+        let top = s.max_coefficient(&[]);
+        assert_eq!(top, s.law(1723.0).0);
+        assert!(s.law(1713.06).0 > top);
     }
 }

@@ -260,16 +260,11 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
 
 /// F22 (24) per unit mass on a liquid particle with normal and δ `n_i`,
 /// temperature `t_i`, curvature κ and temperature gradient ∇T:
-/// f[T_i] δ (α' ∇_t T − α κ n)/ρ, α(T) and α' from F22 (8) (α' = 0 where clipped).
+/// f[T_i] δ (α' ∇_t T − α κ n)/ρ, α(T) and α' from F22 (8) with R18 (4.2)'s
+/// solute term (`Params::tension_law`; α' = 0 where clipped).
 #[inline(always)]
 fn force(pr: &Params, n_i: [f32; 4], t_i: f32, kappa: f32, gt: [f32; 3], rho: f32) -> [f32; 3] {
-    let t = &pr.tension;
-    let raw = t.alpha0 + t.alpha_slope * (t_i - t.t_ref);
-    let (alpha, slope) = if raw <= t.alpha_min {
-        (t.alpha_min, 0.0)
-    } else {
-        (raw, t.alpha_slope)
-    };
+    let (alpha, slope) = pr.tension_law(t_i);
     let nt = n_i[0] * gt[0] + n_i[1] * gt[1] + n_i[2] * gt[2];
     let tan = [
         gt[0] - nt * n_i[0],

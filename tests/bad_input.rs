@@ -148,3 +148,34 @@ fn density_law_and_temperature_program_keys() {
         common::assert_input_error(&args, key);
     }
 }
+
+/// R18 (4.2)'s solute term: positive constants, a negative heat of adsorption,
+/// and a heat scene with the reference temperature T_m.
+#[test]
+fn sahoo_keys() {
+    let melt = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/pbf/line_melt_coarse_2d.toml"
+    );
+    let sahoo = |gamma: &str, dh: &str| {
+        format!("surface_tension.sahoo={{ surface_excess = {gamma}, segregation_constant = 0.0032, activity = 0.0022, adsorption_enthalpy = {dh} }}")
+    };
+    let cases = [
+        (
+            sahoo("-1.3e-8", "-1.66e5"),
+            "surface_tension.sahoo.surface_excess",
+        ),
+        (
+            sahoo("1.3e-8", "1.66e5"),
+            "surface_tension.sahoo.adsorption_enthalpy",
+        ),
+    ];
+    for (set, key) in &cases {
+        common::assert_input_error(&["validate", melt, "--set", set], key);
+    }
+    let drop = common::scene("laplace_free_disc_2d");
+    common::assert_input_error(
+        &["validate", &drop, "--set", &sahoo("1.3e-8", "-1.66e5")],
+        "surface_tension.sahoo.surface_excess",
+    );
+}

@@ -55,15 +55,15 @@ impl DensityLaw {
         let (tk, rk) = self.points[k];
         rk + self.slopes()[k] * (t - tk)
     }
-    /// The lowest and highest ρ0 the law reaches over [t_min, t_max].
+    /// The lowest and highest ρ0 the law reaches over [t_min, t_max]: at the
+    /// ends, and at each point inside on both sides (a step has two values).
     pub fn range(&self, t_min: f64, t_max: f64) -> (f64, f64) {
+        let slopes = self.slopes();
         let mut v = vec![self.at(t_min), self.at(t_max)];
-        for (i, p) in self.points.iter().enumerate() {
-            if p.0 > t_min && p.0 < t_max {
-                v.push(p.1);
-                if i > 0 {
-                    v.push(self.at(p.0 - 1e-9 * p.0.abs().max(1.0)));
-                }
+        for (i, &(t, rho)) in self.points.iter().enumerate().skip(1) {
+            if t > t_min && t < t_max {
+                let (t_prev, rho_prev) = self.points[i - 1];
+                v.extend([rho, rho_prev + slopes[i - 1] * (t - t_prev)]);
             }
         }
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);

@@ -7,16 +7,6 @@
 // rho += dt drho/dt and the EOS (continuity_update). Twin of src/backend/cpu/continuity.rs (equations
 // and choices there).
 
-// The EOS p = c²(rho - rho0(T)), clamped at 0 with the pressure floor: the
-// density pass's with the particle's own reference density.
-fn continuity_eos(ph: u32, r: f32, rho0: f32) -> f32 {
-    let p = P.phases[ph].c2 * (r - rho0);
-    if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
-        return max(p, 0.0);
-    }
-    return p;
-}
-
 // Particle i's reference density: its phase's density law at its temperature
 // (the previous step's), else the phase's rho0.
 fn particle_rho0(ph: u32, i: u32) -> f32 {
@@ -172,5 +162,5 @@ fn continuity_update(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     if (is_wall(ph)) { return; }
     let r = rho[i] + sim.dt * continuity[i].x;
     rho[i] = r;
-    press[i] = continuity_eos(ph, r, particle_rho0(ph, i));
+    press[i] = equation_of_state(ph, r, particle_rho0(ph, i));
 }

@@ -4,14 +4,6 @@
 // Summation density rho_i = m_i sum_j W_ij (F22 §3.3) and EOS p = c²(rho - rho0)
 // (F22 (3)), clamped at 0 with the pressure floor. Twin of src/backend/cpu/density.rs.
 
-fn equation_of_state(ph: u32, r: f32) -> f32 {
-    let p = P.phases[ph].c2 * (r - P.phases[ph].rho0);
-    if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
-        return max(p, 0.0);
-    }
-    return p;
-}
-
 @compute @workgroup_size(64)
 fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -30,5 +22,5 @@ fn density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let r = mass[i] * sum;
     rho[i] = r;
-    press[i] = equation_of_state(ph, r);
+    press[i] = equation_of_state(ph, r, P.phases[ph].rho0);
 }

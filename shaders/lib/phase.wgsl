@@ -38,3 +38,14 @@ fn reference_density(ph: u32, t: f32) -> f32 {
     let t_k = P.phases[ph].density[row].temperature[c];
     return P.phases[ph].density[row].value[c] + P.phases[ph].density[row].slope[c] * (t - t_k);
 }
+
+// The EOS p = c²(rho - rho0) about the given reference density (the phase's,
+// or δ-SPH's rho0(T)), clamped at 0 with the pressure floor. Twin of
+// backend::cpu::density::equation_of_state_about.
+fn equation_of_state(ph: u32, r: f32, rho0: f32) -> f32 {
+    let p = P.phases[ph].c2 * (r - rho0);
+    if ((P.sizes.flags & FLAG_PRESSURE_FLOOR) != 0u) {
+        return max(p, 0.0);
+    }
+    return p;
+}

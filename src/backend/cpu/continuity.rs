@@ -33,11 +33,12 @@
 //! every other pass (bodies, heat, the transport velocity) stay as it is.
 
 use super::bodies::point_velocity;
+use super::density::equation_of_state_about;
 use super::neighbors::{
     for_each_neighbor, min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
 use crate::kernel;
-use crate::params::{Params, FLAG_BODIES, FLAG_PRESSURE_FLOOR, PHASE_DENSITY_LAW};
+use crate::params::{Params, FLAG_BODIES, PHASE_DENSITY_LAW};
 use crate::state::{State, H_TEMPERATURE, NO_BODY};
 use rayon::prelude::*;
 
@@ -233,17 +234,6 @@ pub fn update(pr: &Params, st: &mut State) {
             }
             let r = *rho + dt * rates[i][0];
             *rho = r;
-            *p = continuity_eos(pr, ph, r, particle_rho0(pr, heat, ph, i));
+            *p = equation_of_state_about(pr, ph, r, particle_rho0(pr, heat, ph, i));
         });
-}
-
-/// The density pass's EOS with the particle's own reference density.
-#[inline(always)]
-fn continuity_eos(pr: &Params, ph: u32, rho: f32, rho0: f32) -> f32 {
-    let p = pr.phase(ph).c2 * (rho - rho0);
-    if pr.flag(FLAG_PRESSURE_FLOOR) {
-        p.max(0.0)
-    } else {
-        p
-    }
 }

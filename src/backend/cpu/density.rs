@@ -42,8 +42,14 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborLis
 
 #[inline(always)]
 pub fn equation_of_state(pr: &Params, phase: u32, rho: f32) -> f32 {
-    let m = pr.phase(phase);
-    let p = m.c2 * (rho - m.rho0);
+    equation_of_state_about(pr, phase, rho, pr.phase(phase).rho0)
+}
+
+/// p = c²(ρ − ρ0) about a given reference density (δ-SPH's ρ0(T)), clamped at 0
+/// with the pressure floor.
+#[inline(always)]
+pub fn equation_of_state_about(pr: &Params, phase: u32, rho: f32, rho0: f32) -> f32 {
+    let p = pr.phase(phase).c2 * (rho - rho0);
     if pr.flag(FLAG_PRESSURE_FLOOR) {
         p.max(0.0)
     } else {

@@ -16,6 +16,22 @@ fn particle_rho0(ph: u32, i: u32) -> f32 {
     return P.phases[ph].rho0;
 }
 
+// What the density diffusion subtracts from particle i's density (R18 (3.53):
+// its reference density; nothing with density_diffusion = "raw").
+fn diffusion_reference(ph: u32, i: u32) -> f32 {
+    if ((P.sizes.flags & FLAG_RAW_DENSITY_DIFFUSION) != 0u) {
+        return 0.0;
+    }
+    return particle_rho0(ph, i);
+}
+
+// Whether the diffusion acts between phases ph_i and ph_j: one phase (R18
+// (3.53) here), or any two fluids with density_diffusion = "raw".
+fn diffuses_with(ph_i: u32, ph_j: u32) -> bool {
+    return ph_j == ph_i
+        || ((P.sizes.flags & FLAG_RAW_DENSITY_DIFFUSION) != 0u && !is_wall(ph_j));
+}
+
 // The real velocity of a wall or body particle (not the wall pass's ghost).
 fn solid_velocity(j: u32) -> vec3<f32> {
     if ((P.sizes.flags & FLAG_BODIES) != 0u) {
@@ -41,7 +57,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
         density_gradient[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }
-    let excess_i = rho[i] - particle_rho0(ph_i, i);
+    let excess_i = rho[i] - diffusion_reference(ph_i, i);
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
@@ -55,7 +71,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
         let r2 = len2(d);
-        if (r2 < P.kernel.support2 && r2 > 0.0 && phase[j] == ph_i) {
+        if (r2 < P.kernel.support2 && r2 > 0.0 && diffuses_with(ph_i, phase[j])) {
             let r = sqrt(r2);
             let vf = mass[j] / rho[j] * (kernel_dw(r) / r);
             mxx = mxx - vf * d.x * d.x;
@@ -64,7 +80,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
             myy = myy - vf * d.y * d.y;
             myz = myz - vf * d.y * d.z;
             mzz = mzz - vf * d.z * d.z;
-            let db = (rho[j] - particle_rho0(ph_i, j) - excess_i) * vf;
+            let db = (rho[j] - diffusion_reference(ph_i, j) - excess_i) * vf;
             b.x = b.x + db * d.x;
             b.y = b.y + db * d.y;
             b.z = b.z + db * d.z;
@@ -107,7 +123,7 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     let m_i = mass[i];
     let rho0_i = particle_rho0(ph_i, i);
     let c2_i = P.phases[ph_i].c2;
-    let excess_i = rho_i - rho0_i;
+    let excess_i = rho_i - diffusion_reference(ph_i, i);
     let g_i = density_gradient[i];
     let v_i = vel[i];
     let pi = pos[i];
@@ -140,8 +156,8 @@ fn continuity_rate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
                     let f = kernel_dw(r) / r;
                     let ud = (v_i.x - v_j.x) * d.x + (v_i.y - v_j.y) * d.y + (v_i.z - v_j.z) * d.z;
                     div = div + vol_j * ud * f;
-                    if (ph_j == ph_i) {
-                        let dr = rho_j - particle_rho0(ph_i, j) - excess_i;
+                    if (diffuses_with(ph_i, ph_j)) {
+                        let dr = rho_j - diffusion_reference(ph_i, j) - excess_i;
                         let gj = density_gradient[j];
                         let gd = (g_i.x + gj.x) * d.x + (g_i.y + gj.y) * d.y + (g_i.z + gj.z) * d.z;
                         diff = diff - vol_j * (dr + dr + gd) * f;

@@ -45,6 +45,9 @@ pub const FLAG_BODIES: u32 = 4096;
 pub const FLAG_CONTINUITY: u32 = 8192;
 /// δ-SPH with R18 (3.18)'s viscous term (`simulation.viscosity_form = "marrone"`).
 pub const FLAG_MARRONE_VISCOSITY: u32 = 16384;
+/// δ-SPH with the density diffusion on the raw ρ across phases
+/// (`simulation.density_diffusion = "raw"`, R18 Test 4's incompatible variant).
+pub const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -597,6 +600,9 @@ impl Params {
         }
         if m.viscosity_form == crate::scene::ViscosityForm::Marrone {
             p.sizes.flags |= FLAG_MARRONE_VISCOSITY;
+        }
+        if m.density_diffusion == crate::scene::DensityDiffusion::Raw {
+            p.sizes.flags |= FLAG_RAW_DENSITY_DIFFUSION;
         }
         p.consts = SHADER_CONSTS;
         if m.needs_interface() {

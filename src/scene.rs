@@ -90,6 +90,20 @@ pub enum ViscosityForm {
     Marrone,
 }
 
+/// `simulation.density_diffusion` (δ-SPH): what the density diffusion smooths.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DensityDiffusion {
+    /// R18 (3.53): the excess ρ − ρ0(T), between particles of one phase (the
+    /// compatible form).
+    #[default]
+    Excess,
+    /// Antuono et al.'s term on the raw ρ between every pair of fluid
+    /// particles: R18 Test 4's "incompatible" variant, which diffuses density
+    /// across an interface of two ρ0 (kept for that comparison).
+    Raw,
+}
+
 /// `[heat] integrator`: how the enthalpy advances over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -341,6 +355,10 @@ pub struct Simulation {
     /// (`marrone`; 17% weak in shear at h = Δx with the quintic: docs/physics.md).
     #[serde(default)]
     pub viscosity_form: ViscosityForm,
+    /// δ-SPH: diffuse the excess ρ − ρ0(T) (`excess`, default, R18 (3.53)) or
+    /// the raw ρ across phases (`raw`, R18 Test 4's incompatible variant).
+    #[serde(default)]
+    pub density_diffusion: DensityDiffusion,
     #[serde(default = "default_kernel")]
     pub kernel: KernelKind,
     pub h_over_dx: Option<f64>,
@@ -714,6 +732,7 @@ pub struct CheckDef {
     pub energy_tolerance: Option<f64>,
     /// Bed at rest: the time (s) after which no body may move (default: half
     /// the run). Settling: the time after which the fall speed is averaged.
+    /// Thermal expansion, pressure noise: the time after which samples count.
     pub settle_time: Option<f64>,
 }
 
@@ -787,6 +806,9 @@ pub enum CheckKind {
     /// R18 Test 3: two fluids in an open tank, the lower one expanding: each
     /// fluid's height against its true volume over the tank's width (`area`).
     ColumnExpansion,
+    /// R18 Test 4: the RMS departure of interior pressures from their local
+    /// smooth mean, relative to ρ_l g H (checks/noise.rs).
+    PressureNoise,
 }
 
 impl CheckKind {
@@ -818,6 +840,7 @@ impl CheckKind {
             CheckKind::Settling => "settling",
             CheckKind::ThermalExpansion => "thermal_expansion",
             CheckKind::ColumnExpansion => "column_expansion",
+            CheckKind::PressureNoise => "pressure_noise",
         }
     }
 }

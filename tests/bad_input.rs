@@ -67,8 +67,18 @@ fn formulation_and_heat_integration_keys() {
     let dam = common::scene("dam_break_2d");
     let heat = common::scene("conduction_1d");
     let delta = "simulation.formulation=\"delta_wcsph\"";
-    let cases: [(&str, &[&str], &str); 5] = [
+    let cases: [(&str, &[&str], &str); 7] = [
         (&dam, &["simulation.delta=0.1"], "simulation.delta"),
+        (
+            &dam,
+            &["simulation.density_diffusion=\"raw\""],
+            "simulation.density_diffusion",
+        ),
+        (
+            &dam,
+            &[delta, "simulation.density_diffusion=\"smooth\""],
+            "simulation.density_diffusion",
+        ),
         (&dam, &[delta, "simulation.delta=1.5"], "simulation.delta"),
         (
             &dam,

@@ -319,6 +319,18 @@ fn thermal_expansion_by_density_law_and_program() {
     );
 }
 
+/// R18 Test 4's raw-ρ density diffusion (across the two fluids) beside the
+/// compatible one, on the sinking blob at half resolution.
+#[test]
+fn density_diffusion_raw_and_compatible_on_the_sinking_blob() {
+    assert_bit_identical(
+        "sinking_blob_2d",
+        &["simulation.dx=0.04", "simulation.density_diffusion=\"raw\""],
+        200,
+    );
+    assert_bit_identical("sinking_blob_2d", &["simulation.dx=0.04"], 200);
+}
+
 /// R18 (4.2)'s Sahoo law (portable exp and ln inside the surface force) on the
 /// README's line melt (δ-SPH, free-surface tension, Marangoni), its plate
 /// started near the solidus so the melt and its tension appear within the steps.

@@ -268,6 +268,7 @@ const FLAG_WETTING: u32 = 2048u;
 const FLAG_BODIES: u32 = 4096u;
 const FLAG_CONTINUITY: u32 = 8192u;
 const FLAG_MARRONE_VISCOSITY: u32 = 16384u;
+const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;

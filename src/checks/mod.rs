@@ -8,7 +8,8 @@
 //! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
 //! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
-//! expansion.rs (δ-SPH thermal expansion: R18 Tests 1 and 3).
+//! expansion.rs (δ-SPH thermal expansion: R18 Tests 1 and 3), noise.rs (pressure
+//! noise: R18 Test 4).
 
 mod bodies;
 mod compression;
@@ -16,6 +17,7 @@ mod dam_break;
 mod expansion;
 mod flow;
 mod heat;
+mod noise;
 mod tension;
 pub mod thermocapillary;
 mod two_layer;
@@ -156,6 +158,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::ColumnExpansion => {
             Box::new(expansion::ColumnExpansion::new(c.area.unwrap_or(f64::NAN)))
         }
+        CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -145,6 +145,8 @@ pub struct Model {
     pub delta: Option<f64>,
     /// The viscous term (δ-SPH may take R18 (3.18)'s).
     pub viscosity_form: crate::scene::ViscosityForm,
+    /// δ-SPH: what the density diffusion smooths (R18 (3.53) or the raw ρ).
+    pub density_diffusion: crate::scene::DensityDiffusion,
     pub limits: DtLimits,
 }
 
@@ -627,6 +629,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         heat,
         delta,
         viscosity_form: sim.viscosity_form,
+        density_diffusion: sim.density_diffusion,
         limits,
     })
 }
@@ -651,6 +654,10 @@ fn delta_coefficient(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Option<
             }
             Ok(Some(d))
         }
+        _ if sim.density_diffusion != crate::scene::DensityDiffusion::Excess => Err(cx.err(
+            "simulation.density_diffusion",
+            "is the δ-SPH density diffusion's form: set formulation = \"delta_wcsph\" or leave it out",
+        )),
         _ if sim.viscosity_form != crate::scene::ViscosityForm::Morris => Err(cx.err(
             "simulation.viscosity_form",
             "\"marrone\" is R18 (3.18), built for formulation = \"delta_wcsph\" only",

@@ -13,7 +13,10 @@
 //! excess (1% of 7000 kg/m³) is many times the gas's whole density, and
 //! diffusing it blew the gas up within 60–150 steps (two_layer_2d,
 //! sessile_drop_2d); R18 has no gas particles, and its two-fluid column (Test 3)
-//! asks for no diffusion across the interface. c0 is the scene's largest sound speed (one δ h c0
+//! asks for no diffusion across the interface. `density_diffusion = "raw"`
+//! (FLAG_RAW_DENSITY_DIFFUSION) is R18 Test 4's incompatible variant: the term on
+//! ρ itself between every pair of fluid particles, kept to compare against.
+//! c0 is the scene's largest sound speed (one δ h c0
 //! for every pair, so each pair's exchange is antisymmetric).
 //!
 //! A wall or body neighbour enters as in the forces pass: the fluid's mass and
@@ -38,7 +41,7 @@ use super::neighbors::{
     for_each_neighbor, min_image, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
 use crate::kernel;
-use crate::params::{Params, FLAG_BODIES, PHASE_DENSITY_LAW};
+use crate::params::{Params, FLAG_BODIES, FLAG_RAW_DENSITY_DIFFUSION, PHASE_DENSITY_LAW};
 use crate::state::{State, H_TEMPERATURE, NO_BODY};
 use rayon::prelude::*;
 
@@ -51,6 +54,23 @@ fn particle_rho0(pr: &Params, heat: &[[f32; 4]], ph: u32, i: usize) -> f32 {
         return pr.reference_density(ph, heat[i][H_TEMPERATURE]);
     }
     pr.phase(ph).rho0
+}
+
+/// What the density diffusion subtracts from particle i's density: its
+/// reference density (R18 (3.53)), or nothing with `density_diffusion = "raw"`.
+#[inline(always)]
+fn diffusion_reference(pr: &Params, heat: &[[f32; 4]], ph: u32, i: usize) -> f32 {
+    if pr.flag(FLAG_RAW_DENSITY_DIFFUSION) {
+        return 0.0;
+    }
+    particle_rho0(pr, heat, ph, i)
+}
+
+/// Whether the diffusion acts between phases ph_i and ph_j: one phase (R18
+/// (3.53) here), or any two fluids with `density_diffusion = "raw"`.
+#[inline(always)]
+fn diffuses_with(pr: &Params, ph_i: u32, ph_j: u32) -> bool {
+    ph_j == ph_i || (pr.flag(FLAG_RAW_DENSITY_DIFFUSION) && !pr.is_wall(ph_j))
 }
 
 /// The real velocity of wall or body particle j (not the wall pass's ghost).
@@ -82,10 +102,10 @@ pub fn gradients(pr: &Params, st: &mut State, grid: &CellTable) {
             if pr.is_wall(ph_i) {
                 return [0.0; 4];
             }
-            let excess_i = s.rho[i] - particle_rho0(pr, &s.heat, ph_i, i);
+            let excess_i = s.rho[i] - diffusion_reference(pr, &s.heat, ph_i, i);
             let (mut m, mut b) = ([0.0f32; 6], [0.0f32; 3]);
             for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
-                if r2 <= 0.0 || s.phase[j] != ph_i {
+                if r2 <= 0.0 || !diffuses_with(pr, ph_i, s.phase[j]) {
                     return;
                 }
                 let r = r2.sqrt();
@@ -96,7 +116,7 @@ pub fn gradients(pr: &Params, st: &mut State, grid: &CellTable) {
                 m[3] -= vf * d[1] * d[1];
                 m[4] -= vf * d[1] * d[2];
                 m[5] -= vf * d[2] * d[2];
-                let db = (s.rho[j] - particle_rho0(pr, &s.heat, ph_i, j) - excess_i) * vf;
+                let db = (s.rho[j] - diffusion_reference(pr, &s.heat, ph_i, j) - excess_i) * vf;
                 for a in 0..3 {
                     b[a] += db * d[a];
                 }
@@ -142,7 +162,7 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
     let mat_i = pr.phase(ph_i);
     let (rho_i, m_i) = (st.rho[i], st.mass[i]);
     let rho0_i = particle_rho0(pr, &st.heat, ph_i, i);
-    let excess_i = rho_i - rho0_i;
+    let excess_i = rho_i - diffusion_reference(pr, &st.heat, ph_i, i);
     let g_i = st.density_gradient[i];
     let v_i = st.vel[i];
     let pi = st.pos[i];
@@ -172,8 +192,8 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
                 let ud =
                     (v_i[0] - v_j[0]) * d[0] + (v_i[1] - v_j[1]) * d[1] + (v_i[2] - v_j[2]) * d[2];
                 div += vol_j * ud * f;
-                if ph_j == ph_i {
-                    let dr = rho_j - particle_rho0(pr, &st.heat, ph_i, j) - excess_i;
+                if diffuses_with(pr, ph_i, ph_j) {
+                    let dr = rho_j - diffusion_reference(pr, &st.heat, ph_i, j) - excess_i;
                     let g_j = st.density_gradient[j];
                     let gd = (g_i[0] + g_j[0]) * d[0]
                         + (g_i[1] + g_j[1]) * d[1]

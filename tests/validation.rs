@@ -169,9 +169,9 @@ fn dam_break_front_within_10_percent() {
 /// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
 /// 1.25 mm 7.4 / 7.6% and 1.6 / 1.3%, with delays of 12–19 ms. 3D (coarse, with its
 /// wall barrier): 7.5% at ΔT = 0.150, 2.5% at ΔT = 0.185.
-fn front_matches_after_release_delay(name: &str) {
+fn front_matches_after_release_delay(name: &str, sets: &[&str]) {
     assert_stated_tolerance(&scene(name), FRONT_TOLERANCE);
-    let c = run_check(name, &[]);
+    let c = run_check(name, sets);
     for exp in ["koshizuka_oka", "martin_moyce"] {
         let delay = common::figure(&c, &format!("release_delay_{exp}"));
         let error = common::figure(&c, &format!("release_delay_error_{exp}"));
@@ -187,12 +187,35 @@ fn front_matches_after_release_delay(name: &str) {
 
 #[test]
 fn dam_break_2d_front_moves_as_in_the_experiments_after_the_release() {
-    front_matches_after_release_delay("dam_break_2d");
+    front_matches_after_release_delay("dam_break_2d", &[]);
+}
+
+/// The dam break on δ-SPH (no pressure floor, R18's free surface): the front
+/// leads Koshizuka & Oka by 19.8% at T = 2.45 and Martin & Moyce by 18.3%
+/// (summation density: 20.4% / 19.1%), so the lead is not the formulation's;
+/// fails the 10% for the same reason as the test above.
+#[test]
+#[ignore = "δ-SPH surge front 19.8% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
+fn dam_break_front_within_10_percent_on_delta_sph() {
+    let c = run_check("dam_break_2d", DELTA_SPH);
+    assert!(c.value <= FRONT_TOLERANCE, "{}", c.line());
+}
+
+const DELTA_SPH: &[&str] = &[
+    "simulation.formulation=\"delta_wcsph\"",
+    "simulation.pressure_floor=false",
+];
+
+/// δ-SPH with one fitted release delay: K&O 7.8% at ΔT = 0.208 (18 ms), M&M
+/// 1.6% at ΔT = 0.268 (14 ms), beside summation density's 7.5% / 1.8% (25 s).
+#[test]
+fn dam_break_2d_on_delta_sph_moves_as_in_the_experiments_after_the_release() {
+    front_matches_after_release_delay("dam_break_2d", DELTA_SPH);
 }
 
 #[test]
 fn dam_break_3d_front_moves_as_in_the_experiments_after_the_release() {
-    front_matches_after_release_delay("dam_break_3d");
+    front_matches_after_release_delay("dam_break_3d", &[]);
 }
 
 #[test]

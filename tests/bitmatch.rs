@@ -623,6 +623,7 @@ fn rigid_bodies_3d_200_steps() {
 [simulation]
 dimension = 3
 kernel = "wendland_c2"
+h_over_dx = 1.2
 dx = 0.02
 gravity = [0.0, 0.0, -9.81]
 pressure_floor = true
@@ -741,6 +742,7 @@ fn melting_grain_3d_200_steps() {
 [simulation]
 dimension = 3
 kernel = "wendland_c2"
+h_over_dx = 1.2
 dx = 5.0e-6
 gravity = [0.0, 0.0, 0.0]
 pressure_floor = true

@@ -36,7 +36,7 @@ TRANSLATING_LID = [
     "background_pressure=3.125",
 ]
 # Wendland (h = 1.2 dx) lets the barrier reach 1.1 dx: the lattice's first fluid row.
-BARRIER = ["simulation.kernel=wendland_c2",
+BARRIER = ["simulation.kernel=wendland_c2", "simulation.h_over_dx=1.2",
            "simulation.barrier={ radius_dx = 1.1, stiffness = 2000.0, damping = 500.0 }"]
 SCENES = [
     ("dam_break_3d", "dam_break_3d", []),

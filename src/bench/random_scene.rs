@@ -93,8 +93,14 @@ fn shape(r: &mut Rng, dim: usize, ext: &[f64], phase: &str) -> (String, &'static
 pub fn generate(seed: u64) -> RandomScene {
     let mut r = Rng(SplitMix(seed ^ 0x5EED_5CE7E));
     let dim = if r.chance(0.6) { 2 } else { 3 };
-    let kernels = ["quintic", "wendland_c2", "cubic"];
-    let kernel = kernels[r.int(0, 2) as usize];
+    use crate::scene::KernelKind;
+    let kernels = [
+        KernelKind::Quintic,
+        KernelKind::WendlandC2,
+        KernelKind::Cubic,
+    ];
+    let k = kernels[r.int(0, 2) as usize];
+    let kernel = k.name();
     let cells: Vec<u32> = (0..dim)
         .map(|_| {
             if dim == 2 {
@@ -104,12 +110,19 @@ pub fn generate(seed: u64) -> RandomScene {
             }
         })
         .collect();
-    let ext: Vec<f64> = cells.iter().map(|&n| n as f64 * DX).collect();
     // One scene in six is fully periodic without gravity: momentum is then conserved.
     let periodic: Vec<bool> = match r.chance(1.0 / 6.0) {
         true => vec![true; dim],
         false => (0..dim).map(|_| r.chance(0.25)).collect(),
     };
+    // A periodic axis spans at least three kernel supports (validation's rule),
+    // at the kernel's default h/Δx.
+    let support_cells = (3.0 * k.support_factor() * k.default_h_over_dx()).ceil() as u32;
+    let ext: Vec<f64> = cells
+        .iter()
+        .zip(&periodic)
+        .map(|(&n, &p)| if p { n.max(support_cells) } else { n } as f64 * DX)
+        .collect();
     let all_periodic = periodic.iter().all(|&p| p);
     let up = dim - 1;
     // Gravity needs a floor: never along a periodic axis (endless free fall).

@@ -24,7 +24,7 @@ impl KernelKind {
         }
     }
     /// Default h/Δx: where each kernel converges on the flow checks (Poiseuille
-    /// and Couette over Δx = L/15 … L/40, `bench accuracy`; docs/validation.md
+    /// and Couette over Δx = L/15 … L/40, `bench accuracy`; docs/benchmarks.md
     /// has the sweep). The quintic at F22's h = Δx: order 2.08 / 2.04. The
     /// cubic at 1.5Δx (support 3Δx, the quintic's): 1.96 / 1.50, where h = Δx
     /// (SPlisHSPlasH's support 2Δx) gets worse with resolution (−0.66 / −0.14).

@@ -284,7 +284,8 @@ fn temperature_of(ph: u32, h: f32) -> vec2<f32> {
 // Params::programmed_temperature.
 fn programmed_temperature(ph: u32, time: f32) -> f32 {
     let cycle = pm_sin_cycles(P.phases[ph].program_frequency * time);
-    return P.phases[ph].program_temperature + P.phases[ph].program_amplitude * cycle + P.phases[ph].program_rate * min(time, P.phases[ph].program_until);
+    let amplitude = P.phases[ph].program_amplitude + P.phases[ph].program_amplitude_rate * time;
+    return P.phases[ph].program_temperature + amplitude * cycle + P.phases[ph].program_rate * min(time, P.phases[ph].program_until);
 }
 
 fn programmed(ph: u32) -> bool {

@@ -17,6 +17,7 @@ pub mod model;
 pub mod outflow;
 pub mod output;
 pub mod params;
+pub mod pool;
 pub mod portable_math;
 pub mod powder;
 pub mod random;

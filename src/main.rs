@@ -361,18 +361,38 @@ fn cmd_run(
         report.steps, report.sim_time
     );
     if let Some(h) = spatter::diagnostics::heat_diagnostics(&loaded.model, &report.final_state) {
+        // 2D figures are per metre of depth.
+        let (per, vol) = if loaded.model.dim == 2 {
+            ("/m", "m^2/m")
+        } else {
+            ("", "m^3")
+        };
         println!(
-            "heat: max T {:.2} K, enthalpy {:.6e} J, absorbed laser power {:.4e} W, evaporated {:.4e} W, radiated {:.4e} W, melted volume {:.4e}, melt pool depth {:.3e} m, width {:.3e} m, length {:.3e} m",
+            "heat: max T {:.2} K, enthalpy {:.6e} J{per}, absorbed laser power {:.4e} W{per}, evaporated {:.4e} W{per}, radiated {:.4e} W{per}, melted volume {:.4e} {vol}",
             h.max_temperature,
             h.total_enthalpy,
             h.absorbed_laser_power,
             h.evaporated_power,
             h.radiated_power,
             h.melted_volume,
+        );
+        let melts = loaded
+            .model
+            .phases
+            .iter()
+            .any(|p| p.thermal.and_then(|t| t.melting).is_some());
+        if melts {
+            println!(
+            "melt pool now (largest connected melt region): height {:.3e} m, width {:.3e} m, length {:.3e} m, volume {:.4e} {vol}; detached melt: {} regions, {} particles, {:.4e} kg{per}",
             h.pool_depth,
             h.pool_width,
-            h.pool_length
+            h.pool_length,
+            h.pool_volume,
+            h.detached_melt_regions,
+            h.detached_melt_particles,
+            h.detached_melt_mass
         );
+        }
     }
     if let Some(t) = &report.track {
         for line in t.summary(loaded.model.dim) {

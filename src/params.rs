@@ -324,10 +324,11 @@ gpu_struct! {
         /// Thermal expansion (PHASE_DENSITY_LAW, δ-SPH): the density law's
         /// point count; point k is density[k / 4]'s component k % 4.
         pub density_points: u32,
-        /// PHASE_PROGRAM: T(t) = reference + A sin(2π f t) + Ṫ min(t, t_end),
-        /// the reference being the phase's initial temperature.
+        /// PHASE_PROGRAM: T(t) = reference + (A + Ȧ t) sin(2π f t) + Ṫ min(t,
+        /// t_end), the reference being the phase's initial temperature.
         pub program_temperature: f32,
         pub program_amplitude: f32,
+        pub program_amplitude_rate: f32,
         pub program_frequency: f32,
         pub program_rate: f32,
         pub program_until: f32,
@@ -717,7 +718,7 @@ impl Params {
         let p = self.phase(phase);
         let cycle = crate::portable_math::sin_cycles(p.program_frequency * time);
         p.program_temperature
-            + p.program_amplitude * cycle
+            + (p.program_amplitude + p.program_amplitude_rate * time) * cycle
             + p.program_rate * time.min(p.program_until)
     }
     /// (α, dα/dT) of the surface-tension law at T: F22 (8) plus R18 (4.2)'s
@@ -1054,6 +1055,7 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
         b.flags |= PHASE_PROGRAM;
         b.program_temperature = t.temperature as f32;
         b.program_amplitude = p.amplitude as f32;
+        b.program_amplitude_rate = p.amplitude_rate as f32;
         b.program_frequency = p.frequency as f32;
         b.program_rate = p.rate as f32;
         b.program_until = finite_or_max(p.until);

@@ -598,6 +598,10 @@ pub struct TemperatureProgramDef {
     /// K (default 0); needs `period`.
     #[serde(default)]
     pub amplitude: f64,
+    /// K/s (default 0): the amplitude grows as A + Ȧ t (R18 Test 2, whose
+    /// expansion coefficient rises linearly in time); needs `period`.
+    #[serde(default)]
+    pub amplitude_rate: f64,
     /// s.
     pub period: Option<f64>,
     /// K/s (default 0).
@@ -740,6 +744,10 @@ pub struct CheckDef {
     /// the run). Settling: the time after which the fall speed is averaged.
     /// Thermal expansion, pressure noise: the time after which samples count.
     pub settle_time: Option<f64>,
+    /// Rising amplitude: R18's swing of the drop's true density |ρ̄0/ρ̄0(0) − 1|
+    /// at failure (default 0.41: R18 Test 2 split at a 140% density increase,
+    /// 1.41 / 0.59 = 2.4).
+    pub swing: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -812,6 +820,9 @@ pub enum CheckKind {
     /// R18 Test 3: two fluids in an open tank, the lower one expanding: each
     /// fluid's height against its true volume over the tank's width (`area`).
     ColumnExpansion,
+    /// R18 Test 2: Test 1 with an amplitude that grows; the density increase
+    /// reached before the drop splits, against R18's.
+    RisingAmplitude,
     /// R18 Test 4: the RMS departure of interior pressures from their local
     /// smooth mean, relative to ρ_l g H (checks/noise.rs).
     PressureNoise,
@@ -845,6 +856,7 @@ impl CheckKind {
             CheckKind::MeltingGrain => "melting_grain",
             CheckKind::Settling => "settling",
             CheckKind::ThermalExpansion => "thermal_expansion",
+            CheckKind::RisingAmplitude => "rising_amplitude",
             CheckKind::ColumnExpansion => "column_expansion",
             CheckKind::PressureNoise => "pressure_noise",
         }

@@ -10,9 +10,13 @@
 //! it is still there (output_interval × scan speed is the resolution along the
 //! track: 20 µm at 1e-5 s and 2 m/s). A resumed run starts its track at the resume.
 //!
-//! - Melt in the pool: a particle of a conducting condensed phase with liquid
-//!   fraction ≥ ½ whose lower edge is below the initial surface of its slice (a
-//!   droplet flying or lying above the surface is not the pool).
+//! - Melt in the pool: a particle of the largest connected region of melt
+//!   (crate::pool: liquid fraction ≥ ½, neighbours within 1.5Δx) whose lower
+//!   edge is below the initial surface of its slice (a droplet flying, lying
+//!   above the surface or landed apart from the pool is not the pool).
+//! - Pool length and width at a sample: the extent of that region (as
+//!   `/diagnostics`); its depth: the deepest of its particles below the initial
+//!   surface of their slices, − ½Δx.
 //! - Initial surface: per slice, the highest condensed (liquid or solid) particle
 //!   at the first state, + ½Δx.
 //! - Depth: initial surface − (lowest melt particle ever seen in the slice − ½Δx);
@@ -40,6 +44,8 @@ pub struct Track {
     peak_t: Vec<f64>,
     /// The depression under the beam at the last state observed.
     depression_now: Option<f64>,
+    /// The pool's depth below the initial surface at the last state observed.
+    pool_depth_now: f64,
     pub pool: PoolPeaks,
     /// Powder scenes: which particles (by id) have been seen molten.
     molten_ids: Vec<bool>,
@@ -127,6 +133,7 @@ impl Track {
             melt_y: vec![[f64::INFINITY, f64::NEG_INFINITY]; slices],
             peak_t: vec![f64::NEG_INFINITY; slices],
             depression_now: None,
+            pool_depth_now: 0.0,
             pool: PoolPeaks::default(),
             molten_ids: m
                 .powder
@@ -167,13 +174,15 @@ impl Track {
             }
         }
         let time = st.sim.time as f64;
-        let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+        let regions = crate::pool::melt_regions(m, st);
+        let mut in_pool = vec![false; st.active()];
+        regions.pool.iter().for_each(|&i| in_pool[i] = true);
         let mut deepest = f64::NEG_INFINITY;
         for i in 0..st.active() {
             if !condensed(m, st, i) {
                 continue;
             }
-            let [_, t, fl, _] = st.heat[i];
+            let t = st.heat[i][1];
             if t as f64 > self.pool.max_temperature {
                 self.pool.max_temperature = t as f64;
                 self.pool.max_temperature_time = time;
@@ -184,19 +193,21 @@ impl Track {
             self.peak_t[k] = self.peak_t[k].max(t as f64);
             let x = m.to_world(st.pos[i]);
             let z = x[self.up];
-            // Melt in the pool: below the initial surface (a droplet flying or
-            // lying above it is not the pool).
-            if fl < 0.5 || z - 0.5 * self.dx >= self.initial_top[k] {
+            if !in_pool[i] || z - 0.5 * self.dx >= self.initial_top[k] {
                 continue;
             }
             self.lowest_melt[k] = self.lowest_melt[k].min(z);
             deepest = deepest.max(self.initial_top[k] - (z - 0.5 * self.dx));
-            for (a, e) in extent.iter_mut().enumerate().take(m.dim as usize - 1) {
-                *e = [e[0].min(x[a]), e[1].max(x[a])];
-            }
             if m.dim == 3 {
                 let y = x[1];
                 self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
+            }
+        }
+        self.pool_depth_now = deepest.max(0.0);
+        if let Some(e) = crate::diagnostics::PoolExtent::of(m, st, &regions.pool) {
+            self.pool.max_length = self.pool.max_length.max(e.size(0, self.dx));
+            if m.dim == 3 {
+                self.pool.max_width = self.pool.max_width.max(e.size(1, self.dx));
             }
         }
         self.depression_now = self.depression(m, st);
@@ -210,23 +221,17 @@ impl Track {
             self.pool.max_depth = deepest;
             self.pool.max_depth_time = time;
         }
-        if extent[0][0].is_finite() {
-            self.pool.max_length = self
-                .pool
-                .max_length
-                .max(extent[0][1] - extent[0][0] + self.dx);
-            if m.dim == 3 {
-                self.pool.max_width = self
-                    .pool
-                    .max_width
-                    .max(extent[1][1] - extent[1][0] + self.dx);
-            }
-        }
     }
 
     /// The depression under the beam at the state last observed (`/diagnostics`).
     pub fn depression_now(&self) -> Option<f64> {
         self.depression_now
+    }
+
+    /// The pool's depth below the initial surface at the state last observed
+    /// (`/diagnostics` pool_depth).
+    pub fn pool_depth_now(&self) -> f64 {
+        self.pool_depth_now
     }
 
     /// Depth of the surface under the beam below the initial surface (m; > 0:

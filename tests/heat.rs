@@ -371,3 +371,86 @@ fn coarse_line_melt_main_job() {
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
 }
+
+/// Issue 29: a Dirichlet wall particle appears in frames at its fixed
+/// temperature, not at the mirror temperature 2 T_wall − T̃ the conduction pass
+/// gives it (which falls below T_wall beside a colder solid: 2·400 − 300 = 500 K
+/// here at the start, and went to −681 K under a melt pool), with enthalpy 0.
+#[test]
+fn dirichlet_walls_appear_in_frames_at_their_own_temperature() {
+    use spatter::output::{heat_channels, Values};
+    let (l, r) = common::run_loaded(&scene("conduction_1d"), &["run.end_time=5.0"], None);
+    let (m, st) = (&l.model, &r.final_state);
+    let fields = heat_channels(m, st);
+    let column = |name: &str| match &fields.iter().find(|f| f.name == name).unwrap().values {
+        Values::F32(v) => v.clone(),
+        _ => panic!("{name} is not f32"),
+    };
+    let (t, h) = (column("temperature"), column("enthalpy"));
+    let walls: Vec<usize> = (0..st.len())
+        .filter(|&i| m.phases[st.phase[i] as usize].kind == spatter::scene::PhaseKind::Wall)
+        .collect();
+    assert!(!walls.is_empty());
+    // The mirror temperature the state holds differs from T_wall somewhere.
+    assert!(walls
+        .iter()
+        .any(|&i| (st.heat[i][spatter::state::H_TEMPERATURE] - 400.0).abs() > 1.0));
+    for &i in &walls {
+        assert_eq!(t[i], 400.0, "wall particle {i}");
+        assert_eq!(h[i], 0.0, "wall particle {i}");
+    }
+}
+
+/// Issue 29 item 1: the pool is the largest connected region of melt; melt
+/// apart from it (a splashed droplet) is detached and does not stretch the pool.
+/// On line_melt_coarse_2d's plate, a 10 × 5 particle pool at the surface and a
+/// one-particle droplet 30 spacings along x: the pool is 10 Δx long and 5 Δx
+/// high (the droplet used to make it 31 Δx long), one detached region of one
+/// particle with the droplet's mass.
+#[test]
+fn pool_figures_ignore_a_splashed_droplet() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/pbf/line_melt_coarse_2d.toml"
+    );
+    let l = spatter::run::load(path, &[]).unwrap();
+    let (m, mut st) = (l.model, l.state);
+    let plate: Vec<usize> = (0..st.active())
+        .filter(|&i| m.phases[st.phase[i] as usize].kind == spatter::scene::PhaseKind::Solid)
+        .collect();
+    let x = |i: usize| m.to_world(st.pos[i]);
+    let top = plate
+        .iter()
+        .map(|&i| x(i)[1])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let x0 = plate.iter().map(|&i| x(i)[0]).fold(f64::INFINITY, f64::min) + 20.0 * m.dx;
+    let inside = |p: [f64; 3], cols: f64, rows: f64| {
+        p[0] > x0 - 0.5 * m.dx
+            && p[0] < x0 + (cols - 0.5) * m.dx
+            && p[1] > top - (rows - 0.5) * m.dx
+    };
+    let (mut pool, mut drop_mass) = (0, 0.0);
+    let world: Vec<[f64; 3]> = (0..st.active()).map(x).collect();
+    for &i in &plate {
+        let p = world[i];
+        let droplet = (p[0] - (x0 + 40.0 * m.dx)).abs() < 0.5 * m.dx && p[1] > top - 0.5 * m.dx;
+        if inside(p, 10.0, 5.0) || droplet {
+            st.heat[i][2] = 1.0;
+            if droplet {
+                drop_mass = st.mass[i] as f64;
+                // Lift it clear of the plate.
+                st.pos[i][1] += (3.0 * m.dx) as f32;
+            } else {
+                pool += 1;
+            }
+        }
+    }
+    assert_eq!(pool, 50);
+    let h = heat_diagnostics(&m, &st).unwrap();
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-3 * m.dx;
+    assert!(close(h.pool_length, 10.0 * m.dx), "{h:?}");
+    assert!(close(h.pool_depth, 5.0 * m.dx), "{h:?}");
+    assert!(close(h.pool_volume, 50.0 * m.dx * m.dx), "{h:?}");
+    assert_eq!((h.detached_melt_regions, h.detached_melt_particles), (1, 1));
+    assert!((h.detached_melt_mass - drop_mass).abs() < 1e-9 * drop_mass);
+}

@@ -147,8 +147,9 @@ struct Phase {
     contact_sin: f32,        // this wall/solid phase (FLAG_WETTING); a Dirichlet
                              // wall's temperature is per particle (heat.x)
     density_points: u32,     // PHASE_DENSITY_LAW: point k is density[k / 4][k % 4]
-    program_temperature: f32, // PHASE_PROGRAM: T = this + A sin(2 pi f t) + rate min(t, until)
+    program_temperature: f32, // PHASE_PROGRAM: T = this + (A + A' t) sin(2 pi f t) + rate min(t, until)
     program_amplitude: f32,
+    program_amplitude_rate: f32,
     program_frequency: f32,
     program_rate: f32,
     program_until: f32,

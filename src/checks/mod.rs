@@ -8,7 +8,7 @@
 //! tension.rs (Laplace, recoil impulse, drop shape, contact angle),
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
 //! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
-//! expansion.rs (δ-SPH thermal expansion: R18 Tests 1 and 3), noise.rs (pressure
+//! expansion.rs (δ-SPH thermal expansion: R18 Tests 1, 2 and 3), noise.rs (pressure
 //! noise: R18 Test 4).
 
 mod bodies;
@@ -154,6 +154,10 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
             c.settle_time,
             c.band_tolerance,
             c.tolerance,
+        )),
+        CheckKind::RisingAmplitude => Box::new(expansion::RisingAmplitude::new(
+            c.settle_time,
+            c.swing.unwrap_or(0.41),
         )),
         CheckKind::ColumnExpansion => {
             Box::new(expansion::ColumnExpansion::new(c.area.unwrap_or(f64::NAN)))

@@ -7,9 +7,11 @@ use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
 
-/// Heat diagnostics (issue 4). Melt pool: particles with liquid fraction ≥ ½
-/// among the liquid and solid ones; depth below the top of the condensed
-/// material, width across and length along x (3D: width along y).
+/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): the largest
+/// connected region of melt (liquid fraction ≥ ½); its length along x, width
+/// along y (3D) and depth: below the initial surface in scenes with a melt track
+/// (set by the track, crate::track), the region's own height elsewhere. Melt in
+/// other regions (splashed droplets, lone molten grains) is detached.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct HeatDiagnostics {
     pub max_temperature: f64,
@@ -22,6 +24,13 @@ pub struct HeatDiagnostics {
     pub pool_depth: f64,
     pub pool_width: f64,
     pub pool_length: f64,
+    /// The pool's particles × Δx^dim (m³; m² in 2D).
+    pub pool_volume: f64,
+    /// Melt regions apart from the pool, their particles and mass (kg; per
+    /// metre of depth in 2D).
+    pub detached_melt_regions: u64,
+    pub detached_melt_particles: u64,
+    pub detached_melt_mass: f64,
     /// Heat leaving through free surfaces by evaporation F22 (18) (W; W/m in 2D).
     pub evaporated_power: f64,
     /// Heat leaving through free surfaces by radiation (W; W/m in 2D).
@@ -68,12 +77,14 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         pool_depth: 0.0,
         pool_width: 0.0,
         pool_length: 0.0,
+        pool_volume: 0.0,
+        detached_melt_regions: 0,
+        detached_melt_particles: 0,
+        detached_melt_mass: 0.0,
         evaporated_power: 0.0,
         radiated_power: 0.0,
     };
     (d.evaporated_power, d.radiated_power) = surface_loss_power(m, st);
-    let mut top = f64::NEG_INFINITY;
-    let mut pool = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
         if !ph.conducts() {
@@ -82,23 +93,42 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         let [_, t, fl, _] = st.heat[i];
         d.max_temperature = d.max_temperature.max(t as f64);
         d.total_enthalpy += st.mass[i] as f64 * ph.absolute_enthalpy(st.heat[i][0]);
-        if ph.kind == PhaseKind::Gas {
-            continue;
-        }
-        let x = m.to_world(st.pos[i]);
-        top = top.max(x[up]);
-        d.melted_volume += fl as f64 * cell;
-        if fl >= 0.5 {
-            for a in 0..3 {
-                pool[a] = [pool[a][0].min(x[a]), pool[a][1].max(x[a])];
-            }
+        if ph.kind != PhaseKind::Gas {
+            d.melted_volume += fl as f64 * cell;
         }
     }
-    if pool[0][0].is_finite() {
-        let extent = |a: usize| pool[a][1] - pool[a][0] + m.dx;
-        d.pool_depth = top - pool[up][0] + 0.5 * m.dx;
-        d.pool_length = extent(0);
-        d.pool_width = if m.dim == 3 { extent(1) } else { 0.0 };
+    let regions = crate::pool::melt_regions(m, st);
+    d.detached_melt_regions = regions.detached_regions as u64;
+    d.detached_melt_particles = regions.detached_particles as u64;
+    d.detached_melt_mass = regions.detached_mass;
+    if let Some(e) = PoolExtent::of(m, st, &regions.pool) {
+        d.pool_length = e.size(0, m.dx);
+        d.pool_width = if m.dim == 3 { e.size(1, m.dx) } else { 0.0 };
+        d.pool_depth = e.size(up, m.dx);
+        d.pool_volume = regions.pool.len() as f64 * cell;
     }
     Some(d)
+}
+
+/// The bounding box of a set of particles (world coordinates).
+pub struct PoolExtent(pub [[f64; 2]; 3]);
+
+impl PoolExtent {
+    pub fn of(m: &Model, st: &State, members: &[usize]) -> Option<PoolExtent> {
+        if members.is_empty() {
+            return None;
+        }
+        let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+        for &i in members {
+            let x = m.to_world(st.pos[i]);
+            for a in 0..3 {
+                b[a] = [b[a][0].min(x[a]), b[a][1].max(x[a])];
+            }
+        }
+        Some(PoolExtent(b))
+    }
+    /// The extent along axis a, counting each particle as Δx wide.
+    pub fn size(&self, a: usize, dx: f64) -> f64 {
+        self.0[a][1] - self.0[a][0] + dx
+    }
 }

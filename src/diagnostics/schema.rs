@@ -95,10 +95,17 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             ),
             (
                 "pool_depth",
-                "melt pool depth below the top of the condensed material, m".into(),
+                "depth of the melt pool (the largest connected region of melt) below the initial surface in scenes with a melt track, its height elsewhere, m".into(),
             ),
             ("pool_width", "melt pool extent along y (3D), m".into()),
             ("pool_length", "melt pool extent along x, m".into()),
+            ("pool_volume", format!("melt pool particles x dx^dim, {vol}")),
+            (
+                "detached_melt_regions",
+                "connected regions of melt apart from the pool (splashed droplets, lone molten grains)".into(),
+            ),
+            ("detached_melt_particles", "particles in them".into()),
+            ("detached_melt_mass", format!("their mass, kg{unit}")),
             (
                 "evaporated_power",
                 format!("evaporation heat loss, W{unit}"),
@@ -199,9 +206,9 @@ pub fn track_schema() -> serde_json::Value {
                 "properties": {
                     "max_temperature": num("K"),
                     "max_temperature_time": num("s"),
-                    "max_depth": num("m, below the top of the condensed material"),
+                    "max_depth": num("m, below the initial surface (the largest connected region of melt)"),
                     "max_depth_time": num("s"),
-                    "max_length": num("extent along x, m"),
+                    "max_length": num("extent along x of the largest connected region of melt, m"),
                     "max_width": num("extent along y, m (0 in 2D)"),
                     "max_depression": num("deepest the surface under the beam sank below the initial surface, m"),
                     "max_depression_time": num("s")

@@ -72,10 +72,13 @@ impl DensityLaw {
     }
 }
 
-/// T(t) = T0 + A sin(2π t / P) + Ṫ min(t, t_end) (`phases.<name>.temperature_program`).
+/// T(t) = T0 + (A + Ȧ t) sin(2π t / P) + Ṫ min(t, t_end)
+/// (`phases.<name>.temperature_program`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TemperatureProgram {
     pub amplitude: f64,
+    /// Ȧ, K/s.
+    pub amplitude_rate: f64,
     /// 1/P (0 without a cycle).
     pub frequency: f64,
     pub rate: f64,
@@ -86,7 +89,8 @@ pub struct TemperatureProgram {
 impl TemperatureProgram {
     /// The temperature above (or below) the phase's `temperature` at time t.
     pub fn offset(&self, t: f64) -> f64 {
-        self.amplitude * (std::f64::consts::TAU * self.frequency * t).sin()
+        (self.amplitude + self.amplitude_rate * t)
+            * (std::f64::consts::TAU * self.frequency * t).sin()
             + self.rate * t.min(self.until)
     }
 }
@@ -235,9 +239,10 @@ fn temperature_program(
         ));
     }
     let amplitude = cx.non_negative(&k("amplitude"), p.amplitude)?;
+    let amplitude_rate = cx.non_negative(&k("amplitude_rate"), p.amplitude_rate)?;
     let frequency = match p.period {
         Some(period) => 1.0 / cx.positive(&k("period"), period)?,
-        None if amplitude > 0.0 => {
+        None if amplitude > 0.0 || amplitude_rate > 0.0 => {
             return Err(cx.err(&k("period"), "missing: an amplitude needs a period"))
         }
         None => 0.0,
@@ -251,13 +256,19 @@ fn temperature_program(
     };
     let program = TemperatureProgram {
         amplitude,
+        amplitude_rate,
         frequency,
         rate: p.rate,
         until,
     };
     // T stays positive over the run (end_time, or the ramp's end).
     let horizon = scene.run.end_time.unwrap_or(until).min(until);
-    let low = t.coldest() - amplitude + (p.rate * horizon).min(0.0);
+    let peak_amplitude = if amplitude_rate > 0.0 {
+        amplitude + amplitude_rate * scene.run.end_time.unwrap_or(f64::INFINITY)
+    } else {
+        amplitude
+    };
+    let low = t.coldest() - peak_amplitude + (p.rate * horizon).min(0.0);
     if !(low > 0.0) {
         return Err(cx.err(
             key,
@@ -298,13 +309,17 @@ mod tests {
 
     #[test]
     fn a_program_cycles_and_ramps() {
-        let p = TemperatureProgram {
+        let mut p = TemperatureProgram {
             amplitude: 50.0,
+            amplitude_rate: 0.0,
             frequency: 1.0,
             rate: 10.0,
             until: 0.5,
         };
         assert!((p.offset(0.25) - (50.0 + 2.5)).abs() < 1e-9);
         assert!((p.offset(2.0) - 5.0).abs() < 1e-9);
+        // R18 Test 2: the amplitude grows by 20 K/s.
+        p.amplitude_rate = 20.0;
+        assert!((p.offset(2.25) - (50.0 + 45.0 + 5.0)).abs() < 1e-9);
     }
 }

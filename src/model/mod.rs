@@ -506,9 +506,14 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if let Some(b) = c.band_tolerance {
             cx.positive("check.band_tolerance", b)?;
         }
+        if let Some(s) = c.swing {
+            cx.positive("check.swing", s)?;
+        }
         if matches!(
             c.kind,
-            crate::scene::CheckKind::ThermalExpansion | crate::scene::CheckKind::ColumnExpansion
+            crate::scene::CheckKind::ThermalExpansion
+                | crate::scene::CheckKind::RisingAmplitude
+                | crate::scene::CheckKind::ColumnExpansion
         ) && !phases.iter().any(|p| p.density_law.is_some())
         {
             return Err(cx.err(

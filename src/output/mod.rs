@@ -12,7 +12,8 @@ pub mod pointcloud;
 pub mod vtk;
 
 use crate::model::Model;
-use crate::state::State;
+use crate::scene::PhaseKind;
+use crate::state::{State, H_ENTHALPY};
 
 /// Values of one per-particle field, in particle (array) order.
 #[derive(Debug, Clone, PartialEq)]
@@ -142,17 +143,22 @@ pub fn velocity_channels(_m: &Model, st: &State) -> Vec<Field> {
 /// which insulates) has no temperature: it is written as the scene's ambient
 /// temperature, with liquid fraction and enthalpy 0, so that a colour scale over
 /// the frame stays within the temperatures the scene has (0 K used to stretch it).
+/// A Dirichlet wall particle is written at its fixed temperature (heat.x), not
+/// at the mirror temperature 2 T_wall − T̃ the conduction pass gives it (issue
+/// 29: down to −681 K beside a hot pool), with enthalpy 0: a wall has none.
 pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     if st.heat.is_empty() {
         return Vec::new();
     }
     let ambient = m.ambient_temperature as f32;
+    let wall = |i: usize| m.phases[st.phase[i] as usize].kind == PhaseKind::Wall;
     let has_temperature = |i: usize| m.phases[st.phase[i] as usize].thermal.is_some();
     let col = |k: usize| {
         Values::F32(
             (0..st.len())
-                .map(|i| match (k, has_temperature(i)) {
-                    (1, false) => ambient,
+                .map(|i| match (k, has_temperature(i), wall(i)) {
+                    (1, false, _) => ambient,
+                    (1, true, true) => st.heat[i][H_ENTHALPY],
                     _ => st.heat[i][k],
                 })
                 .collect(),
@@ -160,7 +166,10 @@ pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     };
     let enthalpy = Values::F32(
         (0..st.len())
-            .map(|i| m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0]) as f32)
+            .map(|i| match wall(i) {
+                true => 0.0,
+                false => m.phases[st.phase[i] as usize].absolute_enthalpy(st.heat[i][0]) as f32,
+            })
             .collect(),
     );
     vec![

@@ -117,7 +117,8 @@ fn density_law_and_temperature_program_keys() {
     let drop = common::scene("thermal_cycle_drop_2d");
     let column = common::scene("column_expansion_2d");
     let law = "materials.fluid.density_law";
-    let cases: [(&str, &[&str], &str); 7] = [
+    let rising = common::scene("rising_amplitude_drop_2d");
+    let cases: [(&str, &[&str], &str); 10] = [
         (&drop, &["simulation.formulation=\"wcsph\""], law),
         (
             &drop,
@@ -144,6 +145,18 @@ fn density_law_and_temperature_program_keys() {
             &["heat.integrator=\"trapezoidal\""],
             "phases.fluid.temperature_program",
         ),
+        (
+            &rising,
+            &["phases.fluid.temperature_program.amplitude_rate=-1.0"],
+            "phases.fluid.temperature_program.amplitude_rate",
+        ),
+        // 1000 K - 200 K/s x 10 s falls below 0 K.
+        (
+            &rising,
+            &["phases.fluid.temperature_program.amplitude_rate=200.0"],
+            "phases.fluid.temperature_program",
+        ),
+        (&rising, &["check.swing=0.0"], "check.swing"),
         (
             &column,
             &["materials.wall.density_law=[[300.0, 1000.0], [400.0, 900.0]]"],

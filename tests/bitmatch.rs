@@ -317,6 +317,17 @@ fn thermal_expansion_by_density_law_and_program() {
         ],
         200,
     );
+    // R18 Test 2's growing amplitude (fast enough to matter within the steps).
+    assert_bit_identical(
+        "rising_amplitude_drop_2d",
+        &[
+            "simulation.dx=0.1",
+            "run.end_time=0.1",
+            "phases.fluid.temperature_program.period=0.025",
+            "phases.fluid.temperature_program.amplitude_rate=5000.0",
+        ],
+        200,
+    );
 }
 
 /// R18 Test 4's raw-ρ density diffusion (across the two fluids) beside the

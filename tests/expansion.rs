@@ -73,3 +73,19 @@ fn sinking_blob_pressure_is_smooth_only_with_the_compatible_diffusion() {
         wcsph.line()
     );
 }
+
+/// R18 Test 2, the drop of Test 1 under a cycle whose amplitude grows until
+/// the drop splits: the density increase ρ_max/ρ_min − 1 reached before the
+/// first piece comes off (farther than the kernel's support from the rest)
+/// within 5% of R18's "about 140%" (read off a plot; 1.41/0.59 − 1 = 139%).
+/// The scene (dx = R/20, h = 3 dx, 249 s) measures 136%; CI runs dx = R/10
+/// (30 s), which measures 136% too. At h = 2 dx the drop split at 23% (R/20)
+/// and 110% (R/10): the scene says why it departs from the kernel's default.
+#[test]
+fn rising_amplitude_drop_holds_to_r18s_density_increase() {
+    common::assert_stated_tolerance(&scene("rising_amplitude_drop_2d"), 0.05);
+    let c = run_check("rising_amplitude_drop_2d", &["simulation.dx=0.1"]);
+    assert!(c.pass, "{}", c.line());
+    let reached = figure(&c, "density_ratio_increase");
+    assert!(reached > 1.3 && reached < 1.6, "{}", c.line());
+}

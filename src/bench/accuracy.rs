@@ -142,6 +142,17 @@ pub const SWEEPS: &[Sweep] = &[
         quick: false,
     },
     Sweep {
+        name: "rising_amplitude_drop_2d",
+        text: scene_text!("rising_amplitude_drop_2d"),
+        sets: &[],
+        // The drop's radius R = 1 m: 10, 15, 20 Δx (20 Δx: 249 s).
+        length: 1.0,
+        cells: &[10, 15, 20],
+        expected_order: None,
+        why: "R18 Test 2: where the drop splits is set by the expanded rim's neighbours (h), not by the resolution",
+        quick: false,
+    },
+    Sweep {
         name: "column_expansion_2d",
         text: scene_text!("column_expansion_2d"),
         sets: &[],

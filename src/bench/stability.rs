@@ -81,6 +81,10 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),
     (scene_file!("validation/sinking_blob_2d"), &["dx=0.04"]),
     (scene_file!("validation/thermal_cycle_drop_2d"), &["dx=0.1"]),
+    (
+        scene_file!("validation/rising_amplitude_drop_2d"),
+        &["dx=0.1"],
+    ),
     (scene_file!("validation/thermocapillary_2d"), &[]),
     (scene_file!("validation/two_layer_2d"), &["dx=0.01"]),
     (

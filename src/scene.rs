@@ -701,6 +701,24 @@ pub struct WatchdogDef {
     /// Absent (the default): only when it has passed through all the wall layers
     /// (as many Δx as the layers); shallower leaks are measured and warned about.
     pub wall_penetration: Option<f64>,
+    /// Scenes with a liquid and a gas (issue 29): the share of liquid particles
+    /// with no liquid, solid or wall particle within 1.5 Δx (alone in the gas)
+    /// above which the liquid counts as dispersing into its gas (default 0.05;
+    /// at least 10 such particles). A drop that holds together has none: a
+    /// splash sheds droplets of several particles.
+    pub liquid_dispersion: f64,
+    /// What a dispersing liquid does to the run: "stop" (exit 3 with the
+    /// diagnosis, the default) or "warn" (a warning per sample).
+    pub on_dispersion: DispersionAction,
+}
+
+/// `watchdog.on_dispersion`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DispersionAction {
+    #[default]
+    Stop,
+    Warn,
 }
 
 impl Default for WatchdogDef {
@@ -711,6 +729,8 @@ impl Default for WatchdogDef {
             max_density_ratio: 3.0,
             min_dt_ratio: 1e-3,
             wall_penetration: None,
+            liquid_dispersion: 0.05,
+            on_dispersion: DispersionAction::Stop,
         }
     }
 }

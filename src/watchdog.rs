@@ -7,7 +7,7 @@
 //! noticed it.
 
 use crate::model::Model;
-use crate::scene::{OpenSidesPolicy, PhaseKind};
+use crate::scene::{DispersionAction, OpenSidesPolicy, PhaseKind};
 use crate::state::{Sim, State};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -86,7 +86,12 @@ pub fn scan(m: &Model, st: &State) -> Option<Trip> {
             worst = Some((id, field, value, reason));
         }
     }
-    let (id, field, value, reason) = worst?;
+    let Some((id, field, value, reason)) = worst else {
+        return match m.watchdog.on_dispersion {
+            DispersionAction::Stop => dispersion_trip(m, st),
+            DispersionAction::Warn => None,
+        };
+    };
     Some(Trip {
         step: st.sim.step as u64,
         time: st.sim.time as f64,
@@ -94,6 +99,85 @@ pub fn scan(m: &Model, st: &State) -> Option<Trip> {
         field: field.into(),
         value,
         reason,
+    })
+}
+
+/// Particles alone in the gas below which a share does not count (the first
+/// few molten particles of a melt pool under gas may have no liquid beside them).
+pub const MIN_DISPERSED: usize = 10;
+
+/// A liquid dispersing into its gas (issue 29): its particles with no liquid,
+/// solid or wall particle within 1.5 Δx (crate::pool::LINK_DX).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dispersion {
+    pub alone: usize,
+    pub liquid: usize,
+    /// The lowest id among the particles alone.
+    pub first_id: u32,
+}
+
+impl Dispersion {
+    pub fn share(&self) -> f64 {
+        self.alone as f64 / self.liquid.max(1) as f64
+    }
+    /// Past the scene's bound (`watchdog.liquid_dispersion`)?
+    pub fn beyond(&self, m: &Model) -> bool {
+        self.alone >= MIN_DISPERSED && self.share() > m.watchdog.liquid_dispersion
+    }
+    pub fn describe(&self, m: &Model) -> String {
+        format!(
+            "{} of {} liquid particles ({:.1}%) have no liquid, solid or wall particle within {} dx, beyond watchdog.liquid_dispersion = {}: the liquid is dispersing into its gas (F22's liquid-gas interface viscosity, simulation.interface_viscosity, 7.2 for molten steel, holds an interface together)",
+            self.alone,
+            self.liquid,
+            100.0 * self.share(),
+            crate::pool::LINK_DX,
+            m.watchdog.liquid_dispersion
+        )
+    }
+}
+
+/// The dispersion of the liquid of `st`; None in scenes without both a liquid
+/// and a gas phase.
+pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
+    let kind = |i: usize| m.phases[st.phase[i] as usize].kind;
+    let has = |k: PhaseKind| m.phases.iter().any(|p| p.kind == k);
+    if !(has(PhaseKind::Gas) && has(PhaseKind::Liquid)) {
+        return None;
+    }
+    let dense: Vec<usize> = (0..st.active())
+        .filter(|&i| kind(i) != PhaseKind::Gas)
+        .collect();
+    let pos: Vec<[f64; 3]> = dense.iter().map(|&i| m.to_world(st.pos[i])).collect();
+    let (label, n) = crate::pool::connected_regions(&pos, crate::pool::LINK_DX * m.dx, m.dim);
+    let mut size = vec![0usize; n];
+    label.iter().for_each(|&r| size[r] += 1);
+    let mut d = Dispersion {
+        alone: 0,
+        liquid: 0,
+        first_id: u32::MAX,
+    };
+    for (k, &i) in dense.iter().enumerate() {
+        if kind(i) != PhaseKind::Liquid {
+            continue;
+        }
+        d.liquid += 1;
+        if size[label[k]] == 1 {
+            d.alone += 1;
+            d.first_id = d.first_id.min(st.id[i]);
+        }
+    }
+    Some(d)
+}
+
+fn dispersion_trip(m: &Model, st: &State) -> Option<Trip> {
+    let d = dispersion(m, st).filter(|d| d.beyond(m))?;
+    Some(Trip {
+        step: st.sim.step as u64,
+        time: st.sim.time as f64,
+        particle: Some(d.first_id),
+        field: "liquid_dispersion".into(),
+        value: d.share(),
+        reason: d.describe(m),
     })
 }
 
@@ -283,5 +367,43 @@ mod tests {
         assert!(check_sim(&m, &sim).is_some());
         sim.dt = m.limits.min().0 as f32;
         assert!(check_sim(&m, &sim).is_none());
+    }
+
+    /// Issue 29: liquid particles alone in the gas past the scene's share stop
+    /// the run (the lowest id named), or only warn; a drop that holds together
+    /// and a share below the bound pass.
+    #[test]
+    fn catches_a_liquid_dispersing_into_its_gas() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/square_drop_2d.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        let (mut m, mut st) = (l.model, l.state);
+        assert_eq!(scan(&m, &st), None);
+        let liquid: Vec<usize> = (0..st.len())
+            .filter(|&i| m.phases[st.phase[i] as usize].kind == PhaseKind::Liquid)
+            .collect();
+        let d = dispersion(&m, &st).unwrap();
+        assert_eq!((d.alone, d.liquid), (0, liquid.len()));
+        // Scatter 14 of the 256 (5.5%) along a row of the gas, 3 dx apart.
+        let y = 0.01; // the gas below the liquid square (0.025..0.055 m)
+        for (k, &i) in liquid.iter().take(14).enumerate() {
+            st.pos[i][0] = (0.005 + 3.0 * m.dx * k as f64) as f32;
+            st.pos[i][1] = y;
+        }
+        let first = liquid.iter().take(14).map(|&i| st.id[i]).min().unwrap();
+        let t = scan(&m, &st).expect("dispersion");
+        assert_eq!(
+            (t.field.as_str(), t.particle),
+            ("liquid_dispersion", Some(first))
+        );
+        assert!(t.reason.contains("14 of 256"), "{}", t.reason);
+        m.watchdog.liquid_dispersion = 0.06;
+        assert_eq!(scan(&m, &st), None);
+        m.watchdog.liquid_dispersion = 0.05;
+        m.watchdog.on_dispersion = DispersionAction::Warn;
+        assert_eq!(scan(&m, &st), None);
+        assert!(dispersion(&m, &st).unwrap().beyond(&m));
     }
 }

@@ -571,6 +571,12 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     if let Some(depth) = wd.wall_penetration {
         cx.positive("watchdog.wall_penetration", depth)?;
     }
+    if !(wd.liquid_dispersion > 0.0 && wd.liquid_dispersion <= 1.0) {
+        return Err(cx.err(
+            "watchdog.liquid_dispersion",
+            format!("must be a share in (0, 1] (got {})", wd.liquid_dispersion),
+        ));
+    }
     if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
         return Err(cx.err(
             "watchdog.max_density_ratio",

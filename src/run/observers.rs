@@ -63,7 +63,40 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     if crate::track::wanted(m) {
         list.push(Box::new(TrackObserver(None)));
     }
+    if m.watchdog.on_dispersion == crate::scene::DispersionAction::Warn && !opts.quiet {
+        list.push(Box::new(DispersionWarning));
+    }
     list
+}
+
+/// `watchdog.on_dispersion = "warn"`: a warning at every sample at which the
+/// liquid is dispersing into its gas (crate::watchdog::dispersion); with
+/// "stop" the watchdog ends the run instead.
+struct DispersionWarning;
+
+impl Observer for DispersionWarning {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        if !matches!(when, Moment::Sample { .. } | Moment::Final) {
+            return;
+        }
+        if let Some(d) = crate::watchdog::dispersion(m, st).filter(|d| d.beyond(m)) {
+            eprintln!(
+                "warning: t = {:.6e} s: {}",
+                st.sim.time as f64,
+                d.describe(m)
+            );
+        }
+    }
+    fn finish(
+        self: Box<Self>,
+        _m: &Model,
+        _last: &State,
+        _end: &RunEnd,
+        _out: &mut Outputs,
+        _found: &mut Findings,
+    ) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// Show `st` to every observer.

@@ -7,6 +7,7 @@ use spatter::error::InputError;
 use spatter::error::SpatterError;
 use spatter::model::EndCondition;
 use spatter::output::mcap_out::{McapSink, Provenance};
+use spatter::output::pool_csv::PoolCsv;
 use spatter::output::vtk::VtkSink;
 use spatter::params::Params;
 use spatter::run::{self, BackendChoice, Outputs, RunEnd, RunOptions};
@@ -83,6 +84,10 @@ struct OutputArgs {
     /// Write a VTK series (.vtu per frame and particles.pvd) into this folder.
     #[arg(long, value_name = "DIR")]
     vtk: Option<String>,
+    /// Heat scenes: the melt pool's figures per diagnostics record as CSV,
+    /// beside the --out stream (RUN.mcap -> RUN.pool.csv).
+    #[arg(long)]
+    pool_csv: bool,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
     #[arg(long, value_name = "T")]
     checkpoint_every: Option<f64>,
@@ -381,7 +386,8 @@ fn cmd_run(
             .phases
             .iter()
             .any(|p| p.thermal.and_then(|t| t.melting).is_some());
-        if melts {
+        // Laser scenes print the track's pool figures below instead.
+        if melts && report.track.is_none() {
             println!(
             "melt pool now (largest connected melt region): height {:.3e} m, width {:.3e} m, length {:.3e} m, volume {:.4e} {vol}; detached melt: {} regions, {} particles, {:.4e} kg{per}",
             h.pool_depth,
@@ -472,6 +478,19 @@ fn cmd_run(
 fn open_outputs(a: &OutputArgs, l: &run::Loaded, backend: &str) -> Result<Outputs, SpatterError> {
     let io_err = |key: &str, m: String| SpatterError::Input(InputError::new(&l.model.file, key, m));
     let command: Vec<String> = std::env::args().collect();
+    // Refused before any file is written.
+    let pool_csv = match (a.pool_csv, a.out.as_ref()) {
+        (false, _) => None,
+        (true, Some(out)) if !l.state.heat.is_empty() => {
+            Some(format!("{}.pool.csv", out.trim_end_matches(".mcap")))
+        }
+        (true, _) => {
+            return Err(io_err(
+                "--pool-csv",
+                "needs --out (the CSV goes beside the MCAP) and a heat scene".into(),
+            ))
+        }
+    };
     let mut o = Outputs::default();
     o.backend = backend.to_string();
     o.checkpoint_every = a.checkpoint_every;
@@ -487,6 +506,9 @@ fn open_outputs(a: &OutputArgs, l: &run::Loaded, backend: &str) -> Result<Output
     }
     if let Some(d) = &a.vtk {
         o.vtk = Some(VtkSink::create(d).map_err(|e| io_err("--vtk", e))?);
+    }
+    if let Some(path) = &pool_csv {
+        o.pool_csv = Some(PoolCsv::create(path).map_err(|e| io_err("--pool-csv", e))?);
     }
     let ckpt_dir = a.checkpoint_dir.clone().or_else(|| {
         a.out

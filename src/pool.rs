@@ -7,8 +7,13 @@
 //! - Connected: two melt particles closer than 1.5 Δx (the lattice's nearest
 //!   and diagonal neighbours at 1 and 1.41 Δx; a droplet one spacing clear of
 //!   the pool is apart from it).
-//! - The pool: the region with the most particles; every other region is
-//!   detached melt, counted by regions, particles and mass.
+//! - The pool: in scenes with a melt track (crate::track), every region that
+//!   reaches below the initial surface (a particle's lower edge below its
+//!   slice's initial top: the melt in the plate or bed, even where a keyhole or
+//!   a mushy particle parts it in two); elsewhere, or before any region does,
+//!   the region with the most particles. Every other region is detached melt
+//!   (droplets flying or landed on the surface), counted by regions, particles
+//!   and mass.
 
 use crate::model::Model;
 use crate::scene::PhaseKind;
@@ -89,8 +94,15 @@ pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, 
     (label, n)
 }
 
-/// The melt regions of `st` (empty outside heat scenes).
+/// The melt regions of `st` (empty outside heat scenes), the pool being the
+/// largest region.
 pub fn melt_regions(m: &Model, st: &State) -> MeltRegions {
+    melt_regions_in(m, st, |_| false)
+}
+
+/// The melt regions of `st`, the pool being every region with a particle for
+/// which `in_pool` (a state index) holds; the largest region when none has.
+pub fn melt_regions_in(m: &Model, st: &State, in_pool: impl Fn(usize) -> bool) -> MeltRegions {
     if st.heat.is_empty() {
         return MeltRegions::default();
     }
@@ -101,21 +113,30 @@ pub fn melt_regions(m: &Model, st: &State) -> MeltRegions {
         return MeltRegions::default();
     }
     let mut size = vec![(0usize, 0.0f64); n];
+    let mut chosen = vec![false; n];
     for (k, &r) in label.iter().enumerate() {
         size[r].0 += 1;
         size[r].1 += st.mass[melt[k]] as f64;
+        chosen[r] |= in_pool(melt[k]);
     }
-    // The largest region; ties to the first.
-    let pool = (0..n).fold(0, |best, r| if size[r].0 > size[best].0 { r } else { best });
-    MeltRegions {
-        pool: (0..melt.len())
-            .filter(|&k| label[k] == pool)
-            .map(|k| melt[k])
-            .collect(),
-        detached_regions: n - 1,
-        detached_particles: melt.len() - size[pool].0,
-        detached_mass: size.iter().map(|s| s.1).sum::<f64>() - size[pool].1,
+    if !chosen.contains(&true) {
+        // The largest region; ties to the first.
+        let largest = (0..n).fold(0, |best, r| if size[r].0 > size[best].0 { r } else { best });
+        chosen[largest] = true;
     }
+    let mut out = MeltRegions::default();
+    for r in 0..n {
+        if !chosen[r] {
+            out.detached_regions += 1;
+            out.detached_particles += size[r].0;
+            out.detached_mass += size[r].1;
+        }
+    }
+    out.pool = (0..melt.len())
+        .filter(|&k| chosen[label[k]])
+        .map(|k| melt[k])
+        .collect();
+    out
 }
 
 #[cfg(test)]

@@ -174,6 +174,8 @@ impl RunReport {
 pub struct Outputs {
     pub mcap: Option<McapSink>,
     pub vtk: Option<VtkSink>,
+    /// `--pool-csv`: the melt pool's time series beside the MCAP.
+    pub pool_csv: Option<crate::output::pool_csv::PoolCsv>,
     pub checkpoints: Option<CheckpointSink>,
     /// Simulated time between periodic checkpoints; None writes them only at the end,
     /// on interruption and on an instability stop.
@@ -222,6 +224,9 @@ impl Outputs {
         let mut d = diagnostics::record(m, st);
         for o in observers {
             o.annotate(&mut d);
+        }
+        if let Some(csv) = self.pool_csv.as_mut() {
+            csv.record(&d)?;
         }
         s.message(DIAGNOSTICS_TOPIC, d.time, &d)
     }

@@ -10,13 +10,13 @@
 //! it is still there (output_interval × scan speed is the resolution along the
 //! track: 20 µm at 1e-5 s and 2 m/s). A resumed run starts its track at the resume.
 //!
-//! - Melt in the pool: a particle of the largest connected region of melt
-//!   (crate::pool: liquid fraction ≥ ½, neighbours within 1.5Δx) whose lower
-//!   edge is below the initial surface of its slice (a droplet flying, lying
-//!   above the surface or landed apart from the pool is not the pool).
-//! - Pool length and width at a sample: the extent of that region (as
-//!   `/diagnostics`); its depth: the deepest of its particles below the initial
-//!   surface of their slices, − ½Δx.
+//! - The pool (crate::pool): the connected regions of melt (liquid fraction
+//!   ≥ ½, neighbours within 1.5Δx) that reach below the initial surface (a
+//!   particle's lower edge below its slice's initial surface); a droplet flying,
+//!   or landed on the surface, is detached melt, not the pool.
+//! - Pool length and width at a sample: the extent of the pool (written into
+//!   `/diagnostics`, with its volume and the detached melt); its depth: the
+//!   deepest of its particles below the initial surface of their slices, − ½Δx.
 //! - Initial surface: per slice, the highest condensed (liquid or solid) particle
 //!   at the first state, + ½Δx.
 //! - Depth: initial surface − (lowest melt particle ever seen in the slice − ½Δx);
@@ -27,6 +27,7 @@
 //!   from the bottom up and ends at the first gap wider than 1.5Δx, so a droplet
 //!   flying above the surface does not count as surface.
 
+use crate::diagnostics::PoolFigures;
 use crate::model::Model;
 use crate::scene::PhaseKind;
 use crate::state::State;
@@ -44,8 +45,9 @@ pub struct Track {
     peak_t: Vec<f64>,
     /// The depression under the beam at the last state observed.
     depression_now: Option<f64>,
-    /// The pool's depth below the initial surface at the last state observed.
-    pool_depth_now: f64,
+    /// The pool's figures at the last state observed (depth below the
+    /// initial surface).
+    pool_now: PoolFigures,
     pub pool: PoolPeaks,
     /// Powder scenes: which particles (by id) have been seen molten.
     molten_ids: Vec<bool>,
@@ -133,7 +135,7 @@ impl Track {
             melt_y: vec![[f64::INFINITY, f64::NEG_INFINITY]; slices],
             peak_t: vec![f64::NEG_INFINITY; slices],
             depression_now: None,
-            pool_depth_now: 0.0,
+            pool_now: PoolFigures::default(),
             pool: PoolPeaks::default(),
             molten_ids: m
                 .powder
@@ -174,7 +176,12 @@ impl Track {
             }
         }
         let time = st.sim.time as f64;
-        let regions = crate::pool::melt_regions(m, st);
+        let below = |i: usize| {
+            let z = m.to_world(st.pos[i])[self.up] - 0.5 * self.dx;
+            self.slice(m, st, i)
+                .is_some_and(|k| z < self.initial_top[k])
+        };
+        let regions = crate::pool::melt_regions_in(m, st, below);
         let mut in_pool = vec![false; st.active()];
         regions.pool.iter().for_each(|&i| in_pool[i] = true);
         let mut deepest = f64::NEG_INFINITY;
@@ -203,13 +210,9 @@ impl Track {
                 self.melt_y[k] = [self.melt_y[k][0].min(y), self.melt_y[k][1].max(y)];
             }
         }
-        self.pool_depth_now = deepest.max(0.0);
-        if let Some(e) = crate::diagnostics::PoolExtent::of(m, st, &regions.pool) {
-            self.pool.max_length = self.pool.max_length.max(e.size(0, self.dx));
-            if m.dim == 3 {
-                self.pool.max_width = self.pool.max_width.max(e.size(1, self.dx));
-            }
-        }
+        self.pool_now = PoolFigures::of(m, st, &regions, Some(deepest.max(0.0)));
+        self.pool.max_length = self.pool.max_length.max(self.pool_now.length);
+        self.pool.max_width = self.pool.max_width.max(self.pool_now.width);
         self.depression_now = self.depression(m, st);
         if let Some(d) = self.depression_now {
             if d > self.pool.max_depression {
@@ -228,10 +231,9 @@ impl Track {
         self.depression_now
     }
 
-    /// The pool's depth below the initial surface at the state last observed
-    /// (`/diagnostics` pool_depth).
-    pub fn pool_depth_now(&self) -> f64 {
-        self.pool_depth_now
+    /// The pool's figures at the state last observed (`/diagnostics`).
+    pub fn pool_now(&self) -> PoolFigures {
+        self.pool_now
     }
 
     /// Depth of the surface under the beam below the initial surface (m; > 0:

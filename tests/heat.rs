@@ -401,12 +401,15 @@ fn dirichlet_walls_appear_in_frames_at_their_own_temperature() {
     }
 }
 
-/// Issue 29 item 1: the pool is the largest connected region of melt; melt
-/// apart from it (a splashed droplet) is detached and does not stretch the pool.
-/// On line_melt_coarse_2d's plate, a 10 × 5 particle pool at the surface and a
-/// one-particle droplet 30 spacings along x: the pool is 10 Δx long and 5 Δx
-/// high (the droplet used to make it 31 Δx long), one detached region of one
-/// particle with the droplet's mass.
+/// Issue 29 item 1: melt apart from the pool (a splashed droplet) is detached
+/// and does not stretch the pool. On line_melt_coarse_2d's plate, a 10 × 5
+/// particle pool at the surface and a one-particle droplet lifted 3 Δx clear
+/// 30 spacings along x: without the track (the largest region) the pool is 10 Δx
+/// long and 5 Δx high (the droplet used to make it 31 Δx long), one detached
+/// region of one particle with the droplet's mass. The track's pool (regions
+/// reaching below the initial surface) is the same, 5 Δx deep; a second patch
+/// of melt in the plate, parted from the first by one solid column (as a
+/// keyhole parts a 2D pool), joins it: 14 Δx long.
 #[test]
 fn pool_figures_ignore_a_splashed_droplet() {
     let path = concat!(
@@ -415,6 +418,7 @@ fn pool_figures_ignore_a_splashed_droplet() {
     );
     let l = spatter::run::load(path, &[]).unwrap();
     let (m, mut st) = (l.model, l.state);
+    let initial = st.clone();
     let plate: Vec<usize> = (0..st.active())
         .filter(|&i| m.phases[st.phase[i] as usize].kind == spatter::scene::PhaseKind::Solid)
         .collect();
@@ -453,4 +457,23 @@ fn pool_figures_ignore_a_splashed_droplet() {
     assert!(close(h.pool_volume, 50.0 * m.dx * m.dx), "{h:?}");
     assert_eq!((h.detached_melt_regions, h.detached_melt_particles), (1, 1));
     assert!((h.detached_melt_mass - drop_mass).abs() < 1e-9 * drop_mass);
+    let mut track = spatter::track::Track::new(&m, &initial).unwrap();
+    track.observe(&m, &st);
+    let p = track.pool_now();
+    assert!(
+        close(p.length, 10.0 * m.dx) && close(p.depth, 5.0 * m.dx),
+        "{p:?}"
+    );
+    assert_eq!((p.detached_regions, p.detached_particles), (1, 1));
+    // A 3 × 2 patch one solid column beyond the pool's end.
+    for &i in &plate {
+        let p = world[i];
+        if p[0] > x0 + 10.5 * m.dx && p[0] < x0 + 13.5 * m.dx && p[1] > top - 1.5 * m.dx {
+            st.heat[i][2] = 1.0;
+        }
+    }
+    track.observe(&m, &st);
+    let p = track.pool_now();
+    assert!(close(p.length, 14.0 * m.dx), "{p:?}");
+    assert!(close(p.volume, 56.0 * m.dx * m.dx), "{p:?}");
 }

@@ -440,6 +440,7 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
         "dx=4e-3",
         "--out",
         s(&mcap),
+        "--pool-csv",
     ]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
@@ -447,6 +448,17 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
         stdout.lines().any(|l| l.starts_with("heat: max T ")),
         "{stdout}"
     );
+    // The pool's series beside the MCAP, a row per /diagnostics record, and
+    // its plot.
+    let csv = std::fs::read_to_string(dir.join("s.pool.csv")).unwrap();
+    let mut rows = csv.lines();
+    assert_eq!(rows.next(), Some(spatter::output::pool_csv::HEADER));
+    let n = rows.clone().count();
+    assert!(rows.all(|r| r.split(',').count() == 10), "{csv}");
+    let png = dir.join("pool.png");
+    let plotted = common::reader(&["pool", s(&mcap), s(&png)]);
+    assert_eq!(plotted.status.code(), Some(0), "{:?}", text(&plotted));
+    assert!(png.exists());
     let sum = summary(&mcap);
     for f in ["temperature", "liquid_fraction", "enthalpy"] {
         assert!(
@@ -465,6 +477,12 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
     }
     let t_max = last["max_temperature"].as_f64().unwrap();
     assert!(t_max > 600.0 && t_max < 700.0, "{last}");
+    assert_eq!(Some(n as u64), sum["diagnostics"].as_u64(), "{sum}");
+    // Without --out there is nowhere beside to write it: exit 2.
+    common::assert_input_error(
+        &["run", &common::scene("stefan_1d"), "--pool-csv"],
+        "--pool-csv",
+    );
 }
 
 /// The 3D dam break at Δx = 4 cm, without its wall barrier: the scene file.

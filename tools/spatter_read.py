@@ -10,6 +10,10 @@ Commands:
     spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
     spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
     spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
+    spatter_read.py pool RUN.mcap OUT.png        melt pool against time (the largest connected region of melt:
+                                                 length, width, depth, depression under the beam, volume; the
+                                                 detached melt: regions and mass; peak temperature), the same
+                                                 series `spatter run --pool-csv` writes as RUN.pool.csv
     spatter_read.py track RUN.mcap OUT.png       laser track: remelt depth and surface height along x,
                                                  and a cross-section of the last frame (2D: the x-z
                                                  plane; 3D: y-z through the track's middle)
@@ -199,6 +203,42 @@ def plot(path, png):
     fig.savefig(png, dpi=100)
 
 
+def pool(path, png):
+    """The melt pool's figures of every /diagnostics record against time."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    _, diagnostics, _ = read_mcap(path)
+    rows = [d for d in diagnostics if "pool_length" in d]
+    if not rows:
+        raise SystemExit(f"{path}: no melt pool figures (not a heat scene)")
+    t = np.array([d["time"] for d in rows]) * 1e3
+    col = lambda k: np.array([d.get(k) if d.get(k) is not None else np.nan for d in rows], float)
+    fig, (a, b, c) = plt.subplots(3, 1, figsize=(8, 9), sharex=True)
+    for key, label in [("pool_length", "length"), ("pool_width", "width"), ("pool_depth", "depth"),
+                       ("depression_depth", "depression under the beam")]:
+        v = col(key)
+        if np.any(np.isfinite(v) & (v != 0)):
+            a.plot(t, v * 1e6, marker=".", label=label)
+    a.set_ylabel("µm")
+    a.legend(fontsize=8)
+    a.set_title("melt pool: the largest connected region of melt")
+    b.plot(t, col("detached_melt_regions"), marker=".", label="detached regions")
+    b.set_ylabel("regions")
+    b2 = b.twinx()
+    b2.plot(t, col("detached_melt_mass"), color="tab:red", marker=".", label="detached mass")
+    b2.set_ylabel("detached mass (kg)")
+    b.set_title("detached melt (splashes, lone molten grains)")
+    c.plot(t, col("max_temperature"), marker=".")
+    c.set_ylabel("peak temperature (K)")
+    c.set_xlabel("simulated time (ms)")
+    for ax in (a, b, c):
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(Path(path).name)
+    fig.tight_layout()
+    fig.savefig(png, dpi=100)
+
+
 def track(path, png):
     """Profile of the track along x and a cross-section of the last frame."""
     import matplotlib
@@ -285,6 +325,8 @@ def main(argv):
         print(json.dumps(summary(path)))
     elif cmd == "plot" and len(argv) == 4:
         plot(path, argv[3])
+    elif cmd == "pool" and len(argv) == 4:
+        pool(path, argv[3])
     elif cmd == "track" and len(argv) == 4:
         track(path, argv[3])
     elif cmd == "export-last" and len(argv) == 4:

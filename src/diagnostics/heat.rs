@@ -7,11 +7,12 @@ use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
 
-/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): the largest
-/// connected region of melt (liquid fraction ≥ ½); its length along x, width
-/// along y (3D) and depth: below the initial surface in scenes with a melt track
-/// (set by the track, crate::track), the region's own height elsewhere. Melt in
-/// other regions (splashed droplets, lone molten grains) is detached.
+/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): connected
+/// regions of melt (liquid fraction ≥ ½). In scenes with a melt track the
+/// track sets the pool's figures (crate::track: the regions reaching below the
+/// initial surface, depth below it); elsewhere the pool is the largest region
+/// and its depth is its height. Melt in other regions (splashed droplets) is
+/// detached.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct HeatDiagnostics {
     pub max_temperature: f64,
@@ -64,7 +65,6 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
     if st.heat.is_empty() {
         return None;
     }
-    let up = m.dim as usize - 1;
     let cell = m.dx.powi(m.dim as i32);
     let mut d = HeatDiagnostics {
         max_temperature: f64::NEG_INFINITY,
@@ -97,17 +97,55 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
             d.melted_volume += fl as f64 * cell;
         }
     }
-    let regions = crate::pool::melt_regions(m, st);
-    d.detached_melt_regions = regions.detached_regions as u64;
-    d.detached_melt_particles = regions.detached_particles as u64;
-    d.detached_melt_mass = regions.detached_mass;
-    if let Some(e) = PoolExtent::of(m, st, &regions.pool) {
-        d.pool_length = e.size(0, m.dx);
-        d.pool_width = if m.dim == 3 { e.size(1, m.dx) } else { 0.0 };
-        d.pool_depth = e.size(up, m.dx);
-        d.pool_volume = regions.pool.len() as f64 * cell;
-    }
+    PoolFigures::of(m, st, &crate::pool::melt_regions(m, st), None).write(&mut d);
     Some(d)
+}
+
+/// The melt pool's figures at one state (`/diagnostics`, crate::pool).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PoolFigures {
+    pub depth: f64,
+    pub width: f64,
+    pub length: f64,
+    pub volume: f64,
+    pub detached_regions: u64,
+    pub detached_particles: u64,
+    pub detached_mass: f64,
+}
+
+impl PoolFigures {
+    /// From the state's melt regions; `depth` below the initial surface where
+    /// the caller knows it (the track), else the pool's height.
+    pub fn of(
+        m: &Model,
+        st: &State,
+        r: &crate::pool::MeltRegions,
+        depth: Option<f64>,
+    ) -> PoolFigures {
+        let mut f = PoolFigures {
+            detached_regions: r.detached_regions as u64,
+            detached_particles: r.detached_particles as u64,
+            detached_mass: r.detached_mass,
+            ..PoolFigures::default()
+        };
+        if let Some(e) = PoolExtent::of(m, st, &r.pool) {
+            let up = m.dim as usize - 1;
+            f.length = e.size(0, m.dx);
+            f.width = if m.dim == 3 { e.size(1, m.dx) } else { 0.0 };
+            f.depth = depth.unwrap_or(e.size(up, m.dx));
+            f.volume = r.pool.len() as f64 * m.dx.powi(m.dim as i32);
+        }
+        f
+    }
+    pub fn write(&self, h: &mut HeatDiagnostics) {
+        h.pool_depth = self.depth;
+        h.pool_width = self.width;
+        h.pool_length = self.length;
+        h.pool_volume = self.volume;
+        h.detached_melt_regions = self.detached_regions;
+        h.detached_melt_particles = self.detached_particles;
+        h.detached_melt_mass = self.detached_mass;
+    }
 }
 
 /// The bounding box of a set of particles (world coordinates).

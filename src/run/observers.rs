@@ -173,8 +173,9 @@ impl Observer for WallLeakage {
 }
 
 /// The melt track of a laser scene with melting (issue 16): started on the
-/// initial state, it writes the depression under the beam and the pool's depth
-/// below the initial surface into each `/diagnostics` record and its profile to `/track` at the end.
+/// initial state, it writes the depression under the beam and the pool's
+/// figures (crate::pool, depth below the initial surface) into each
+/// `/diagnostics` record and its profile to `/track` at the end.
 struct TrackObserver(Option<Track>);
 
 impl Observer for TrackObserver {
@@ -188,7 +189,7 @@ impl Observer for TrackObserver {
     fn annotate(&self, d: &mut Diagnostics) {
         d.depression_depth = self.0.as_ref().and_then(Track::depression_now);
         if let (Some(t), Some(h)) = (self.0.as_ref(), d.heat.as_mut()) {
-            h.pool_depth = t.pool_depth_now();
+            t.pool_now().write(h);
         }
     }
     fn finish(

@@ -25,5 +25,6 @@ pub mod run;
 pub mod scene;
 pub mod setup;
 pub mod state;
+pub mod sweep;
 pub mod track;
 pub mod watchdog;

@@ -69,6 +69,32 @@ enum Command {
         #[arg(long)]
         by_tolerance: bool,
     },
+    /// Process maps: run a grid of --set overrides (`sweep SCENE --vary
+    /// KEY=V1,V2 ... --out DIR`), write it as a Slurm job array (--slurm), run
+    /// one cell (`sweep cell DIR I`, what each array task runs) or gather the
+    /// runs into a CSV and a map (`sweep collect DIR`).
+    Sweep {
+        /// SCENE, or `cell DIR I`, or `collect DIR`.
+        #[arg(required = true, num_args = 1..=3)]
+        args: Vec<String>,
+        /// A key and its values: KEY=V1,V2,... (repeat for a grid).
+        #[arg(long, value_name = "KEY=V1,V2")]
+        vary: Vec<String>,
+        /// Overrides every run shares.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Runs at a time on this machine.
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// The sweep's folder.
+        #[arg(long, value_name = "DIR", default_value = "sweep")]
+        out: String,
+        #[arg(long, value_enum, default_value = "auto")]
+        backend: BackendChoice,
+        /// Write the manifest and a Slurm job-array script instead of running.
+        #[arg(long)]
+        slurm: bool,
+    },
     /// Benchmarks.
     Bench {
         #[command(subcommand)]
@@ -88,6 +114,10 @@ struct OutputArgs {
     /// beside the --out stream (RUN.mcap -> RUN.pool.csv).
     #[arg(long)]
     pool_csv: bool,
+    /// Write the run's figures as JSON at its end (how it ended, cost, the
+    /// track's pool figures, the check): what `spatter sweep` collects.
+    #[arg(long, value_name = "FILE")]
+    summary: Option<String>,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
     #[arg(long, value_name = "T")]
     checkpoint_every: Option<f64>,
@@ -219,6 +249,15 @@ fn main() -> ExitCode {
             by_tolerance,
         } => cmd_compare(&scenario, steps, &sets, by_tolerance),
         Command::Bench { which } => cmd_bench(which),
+        Command::Sweep {
+            args,
+            vary,
+            sets,
+            jobs,
+            out,
+            backend,
+            slurm,
+        } => cmd_sweep(&args, &vary, &sets, jobs, &out, backend, slurm),
     };
     match result {
         Ok(code) => code,
@@ -231,6 +270,122 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+fn cmd_sweep(
+    args: &[String],
+    vary: &[String],
+    sets: &[String],
+    jobs: usize,
+    out: &str,
+    backend: BackendChoice,
+    slurm: bool,
+) -> Result<ExitCode, SpatterError> {
+    use spatter::sweep;
+    use std::path::Path;
+    let exe = std::env::current_exe().map_err(|e| SpatterError::Runtime(e.to_string()))?;
+    let rt = SpatterError::Runtime;
+    match args {
+        [c, dir] if c == "collect" => {
+            let (csv, png) = sweep::collect(Path::new(dir)).map_err(rt)?;
+            println!("sweep: {}", csv.display());
+            match png {
+                Some(p) => println!("sweep: {}", p.display()),
+                None => println!("sweep: no map (fewer than one numeric key, or runs missing)"),
+            }
+            return Ok(ExitCode::SUCCESS);
+        }
+        [c, dir, i] if c == "cell" => {
+            let i: usize = i.parse().map_err(|_| {
+                SpatterError::Input(InputError::new(
+                    dir,
+                    "INDEX",
+                    format!("not a cell index: {i}"),
+                ))
+            })?;
+            let s = sweep::run_cell(Path::new(dir), i, &exe).map_err(rt)?;
+            println!("cell {i} {:?}: exit {:?}", s.vary, s.exit_code);
+            return Ok(ExitCode::SUCCESS);
+        }
+        [_] => {}
+        _ => {
+            return Err(InputError::new(
+                "sweep",
+                "",
+                "expected SCENE, `cell DIR INDEX` or `collect DIR`",
+            )
+            .into())
+        }
+    }
+    let scene = std::fs::canonicalize(&args[0])
+        .map_err(|e| InputError::new(&args[0], "", format!("cannot read scenario: {e}")))?;
+    let scene = scene.to_string_lossy().to_string();
+    if vary.is_empty() {
+        return Err(InputError::new(&scene, "--vary", "give at least one KEY=V1,V2,...").into());
+    }
+    let mut lists = Vec::new();
+    for v in vary {
+        lists.push(sweep::parse_vary(v).map_err(|m| InputError::new(&scene, "--vary", m))?);
+    }
+    let cells = sweep::grid(&lists);
+    // Every cell must load: a bad value is refused before anything runs.
+    for c in &cells {
+        let mut all = sets.to_vec();
+        all.extend(c.vary.iter().map(|(k, v)| format!("{k}={v}")));
+        run::load(&scene, &all)?;
+    }
+    let backend = match backend {
+        BackendChoice::Auto => "auto",
+        BackendChoice::Cpu => "cpu",
+        BackendChoice::Gpu => "gpu",
+    };
+    let manifest = sweep::Manifest {
+        scene,
+        backend: backend.into(),
+        sets: sets.to_vec(),
+        keys: lists.iter().map(|l| l.0.clone()).collect(),
+        cells,
+    };
+    let dir = Path::new(out);
+    if let Ok(old) = sweep::read_manifest(dir) {
+        if old.cells != manifest.cells || old.scene != manifest.scene || old.sets != manifest.sets {
+            return Err(InputError::new(
+                out,
+                "--out",
+                "holds a different sweep (its manifest.json): give another folder",
+            )
+            .into());
+        }
+    }
+    sweep::write_manifest(dir, &manifest).map_err(rt)?;
+    if slurm {
+        let script = dir.join("sweep.slurm");
+        let dir_abs = std::fs::canonicalize(dir).map_err(|e| rt(e.to_string()))?;
+        spatter::output::write_atomic(
+            &script,
+            sweep::slurm_script(&dir_abs, &exe, manifest.cells.len()).as_bytes(),
+        )
+        .map_err(rt)?;
+        println!(
+            "sweep: {} cells; submit with `sbatch {}`, then `spatter sweep collect {}`",
+            manifest.cells.len(),
+            script.display(),
+            dir.display()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let done = sweep::run_local(dir, jobs, &exe).map_err(rt)?;
+    let failed = done.iter().filter(|s| s.exit_code != Some(0)).count();
+    let (csv, png) = sweep::collect(dir).map_err(rt)?;
+    println!(
+        "sweep: {} runs, {failed} not exit 0; {}",
+        done.len(),
+        csv.display()
+    );
+    if let Some(p) = png {
+        println!("sweep: {}", p.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn cmd_bench(which: BenchKind) -> Result<ExitCode, SpatterError> {
@@ -361,6 +516,16 @@ fn cmd_run(
         resumed: resumed_from.is_some(),
     };
     let report = run::run(&loaded, backend.as_mut(), &opts, &mut outputs)?;
+    if let Some(p) = &out_args.summary {
+        let fig = spatter::sweep::run_figures(&loaded.model, &report);
+        spatter::output::write_atomic(
+            std::path::Path::new(p),
+            serde_json::to_string_pretty(&fig)
+                .unwrap_or_default()
+                .as_bytes(),
+        )
+        .map_err(SpatterError::Runtime)?;
+    }
     println!(
         "steps: {}, simulated time: {:.6e} s",
         report.steps, report.sim_time

@@ -10,10 +10,11 @@
 //! it is still there (output_interval × scan speed is the resolution along the
 //! track: 20 µm at 1e-5 s and 2 m/s). A resumed run starts its track at the resume.
 //!
-//! - The pool (crate::pool): the connected regions of melt (liquid fraction
-//!   ≥ ½, neighbours within 1.5Δx) that reach below the initial surface (a
-//!   particle's lower edge below its slice's initial surface); a droplet flying,
-//!   or landed on the surface, is detached melt, not the pool.
+//! - The pool (crate::pool): the largest connected region of melt (liquid
+//!   fraction ≥ ½, neighbours within 1.5Δx); a droplet flying, or landed on
+//!   the surface or in the track (which sinks below the initial surface), is
+//!   detached melt, not the pool. Melt in the pool counts for a slice where its
+//!   lower edge is below the slice's initial surface.
 //! - Pool length and width at a sample: the extent of the pool (written into
 //!   `/diagnostics`, with its volume and the detached melt); its depth: the
 //!   deepest of its particles below the initial surface of their slices, − ½Δx.
@@ -176,12 +177,7 @@ impl Track {
             }
         }
         let time = st.sim.time as f64;
-        let below = |i: usize| {
-            let z = m.to_world(st.pos[i])[self.up] - 0.5 * self.dx;
-            self.slice(m, st, i)
-                .is_some_and(|k| z < self.initial_top[k])
-        };
-        let regions = crate::pool::melt_regions_in(m, st, below);
+        let regions = crate::pool::melt_regions(m, st);
         let mut in_pool = vec![false; st.active()];
         regions.pool.iter().for_each(|&i| in_pool[i] = true);
         let mut deepest = f64::NEG_INFINITY;

@@ -3,7 +3,7 @@
 //! and `stability` (long runs, parameter extremes and seeded random scenes).
 
 pub mod accuracy;
-mod plot;
+pub mod plot;
 mod random_scene;
 pub mod stability;
 pub mod throughput;

@@ -167,12 +167,17 @@ fn guide_dash(k: usize) -> (u32, u32) {
     [(10, 5), (3, 4), (16, 4), (6, 3)][k % 4]
 }
 
-/// Draw `fig` as a PNG at `path`. A figure with no plottable point is not
-/// written (Ok(false)).
-pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
+/// Register the shipped font as "sans-serif" (once per process).
+pub fn register_fonts() {
     REGISTER.call_once(|| {
         let _ = register_font("sans-serif", FontStyle::Normal, FONT);
     });
+}
+
+/// Draw `fig` as a PNG at `path`. A figure with no plottable point is not
+/// written (Ok(false)).
+pub fn log_log(path: &std::path::Path, fig: &Figure) -> Result<bool, String> {
+    register_fonts();
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let xs = fig.series.iter().flat_map(|s| plottable(s).map(|p| p.0));
     let ys = fig.series.iter().flat_map(|s| plottable(s).map(|p| p.1));

@@ -7,12 +7,11 @@ use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
 
-/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): connected
-/// regions of melt (liquid fraction ≥ ½). In scenes with a melt track the
-/// track sets the pool's figures (crate::track: the regions reaching below the
-/// initial surface, depth below it); elsewhere the pool is the largest region
-/// and its depth is its height. Melt in other regions (splashed droplets) is
-/// detached.
+/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): the largest
+/// connected region of melt (liquid fraction ≥ ½); in scenes with a melt track
+/// the track sets its figures with the depth below the initial surface
+/// (crate::track), elsewhere the depth is its height. Melt in other regions
+/// (splashed droplets) is detached.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct HeatDiagnostics {
     pub max_temperature: f64,

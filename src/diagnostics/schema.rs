@@ -95,7 +95,7 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             ),
             (
                 "pool_depth",
-                "depth of the melt pool below the initial surface in scenes with a melt track (the connected regions of melt reaching below it), the height of the largest connected region of melt elsewhere, m".into(),
+                "depth of the melt pool (the largest connected region of melt) below the initial surface in scenes with a melt track, its height elsewhere, m".into(),
             ),
             ("pool_width", "melt pool extent along y (3D), m".into()),
             ("pool_length", "melt pool extent along x, m".into()),
@@ -206,9 +206,9 @@ pub fn track_schema() -> serde_json::Value {
                 "properties": {
                     "max_temperature": num("K"),
                     "max_temperature_time": num("s"),
-                    "max_depth": num("m, below the initial surface (the connected regions of melt reaching below it)"),
+                    "max_depth": num("m, below the initial surface (the largest connected region of melt)"),
                     "max_depth_time": num("s"),
-                    "max_length": num("extent along x of the pool (the connected regions of melt reaching below the initial surface), m"),
+                    "max_length": num("extent along x of the largest connected region of melt, m"),
                     "max_width": num("extent along y, m (0 in 2D)"),
                     "max_depression": num("deepest the surface under the beam sank below the initial surface, m"),
                     "max_depression_time": num("s")

@@ -589,6 +589,11 @@ pub struct PhaseDef {
     /// until) (R18 Test 1's thermal cycle, Test 3's heating ramp). Liquid, gas and
     /// solid phases without a melting band, explicit heat integration.
     pub temperature_program: Option<TemperatureProgramDef>,
+    /// m/s: this phase's sound speed in place of its material's (R18 §4.4
+    /// lowers it ×5 on melting, so that the melt's expansion does not blow
+    /// particles off the solid: the liquid phase a solid melts into takes its
+    /// own). Fluid phases only.
+    pub sound_speed: Option<f64>,
 }
 
 /// `phases.<name>.temperature_program`.

@@ -202,3 +202,36 @@ fn sahoo_keys() {
         "surface_tension.sahoo.surface_excess",
     );
 }
+
+/// R18 §4.4's sound speed lowered ×5 on melting, as a key: the liquid phase a
+/// solid melts into takes `phases.<name>.sound_speed` in place of its
+/// material's, and the acoustic step limit follows it; a solid or wall phase has
+/// none of its own.
+#[test]
+fn a_phase_takes_its_own_sound_speed() {
+    let melt = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/pbf/line_melt_coarse_2d.toml"
+    );
+    let base = spatter::run::load(melt, &[]).unwrap().model;
+    let slow = spatter::run::load(melt, &["phases.melt.sound_speed=7.34".into()])
+        .unwrap()
+        .model;
+    let c = |m: &spatter::model::Model| {
+        m.phases
+            .iter()
+            .find(|p| p.name == "melt")
+            .unwrap()
+            .sound_speed
+    };
+    assert_eq!((c(&base), c(&slow)), (36.7, 7.34));
+    assert_eq!(slow.max_sound_speed(), 7.34);
+    common::assert_input_error(
+        &["validate", melt, "--set", "phases.plate.sound_speed=10.0"],
+        "phases.plate.sound_speed",
+    );
+    common::assert_input_error(
+        &["validate", melt, "--set", "phases.melt.sound_speed=-1.0"],
+        "phases.melt.sound_speed",
+    );
+}

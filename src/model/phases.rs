@@ -181,6 +181,18 @@ pub(super) fn phase_table(
                 ))
             }
         };
+        let sound_speed = match p.sound_speed {
+            None => sound_speed,
+            Some(c) if matches!(p.kind, PhaseKind::Liquid | PhaseKind::Gas) => {
+                cx.positive(&key("sound_speed"), c)?
+            }
+            Some(_) => {
+                return Err(cx.err(
+                    &key("sound_speed"),
+                    "only fluid (liquid, gas) phases compress: solids and walls have no sound speed of their own",
+                ))
+            }
+        };
         let velocity = match &p.velocity {
             Some(v) if p.kind == PhaseKind::Wall => cx.vector(&key("velocity"), v, dim)?,
             Some(_) => {

@@ -124,6 +124,62 @@ pub fn melt_regions(m: &Model, st: &State) -> MeltRegions {
     }
 }
 
+/// The melt pool's figures at one state (`/diagnostics`, crate::pool).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PoolFigures {
+    pub depth: f64,
+    pub width: f64,
+    pub length: f64,
+    pub volume: f64,
+    pub detached_regions: u64,
+    pub detached_particles: u64,
+    pub detached_mass: f64,
+}
+
+impl PoolFigures {
+    /// From the state's melt regions; `depth` below the initial surface where
+    /// the caller knows it (the track), else the pool's height.
+    pub fn of(m: &Model, st: &State, r: &MeltRegions, depth: Option<f64>) -> PoolFigures {
+        let mut f = PoolFigures {
+            detached_regions: r.detached_regions as u64,
+            detached_particles: r.detached_particles as u64,
+            detached_mass: r.detached_mass,
+            ..PoolFigures::default()
+        };
+        if let Some(e) = PoolExtent::of(m, st, &r.pool) {
+            let up = m.dim as usize - 1;
+            f.length = e.size(0, m.dx);
+            f.width = if m.dim == 3 { e.size(1, m.dx) } else { 0.0 };
+            f.depth = depth.unwrap_or(e.size(up, m.dx));
+            f.volume = r.pool.len() as f64 * m.dx.powi(m.dim as i32);
+        }
+        f
+    }
+}
+
+/// The bounding box of a set of particles (world coordinates).
+pub struct PoolExtent(pub [[f64; 2]; 3]);
+
+impl PoolExtent {
+    pub fn of(m: &Model, st: &State, members: &[usize]) -> Option<PoolExtent> {
+        if members.is_empty() {
+            return None;
+        }
+        let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+        for &i in members {
+            let x = m.to_world(st.pos[i]);
+            for a in 0..3 {
+                b[a] = [b[a][0].min(x[a]), b[a][1].max(x[a])];
+            }
+        }
+        Some(PoolExtent(b))
+    }
+    /// The extent along axis a, counting each particle as Δx wide.
+    pub fn size(&self, a: usize, dx: f64) -> f64 {
+        self.0[a][1] - self.0[a][0] + dx
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,6 +1,7 @@
 //! Loading a scene, choosing a backend and driving the step loop.
 
 mod observers;
+pub mod pool_csv;
 
 use observers::observe_all;
 pub use observers::{Findings, Moment, Observer};
@@ -175,7 +176,7 @@ pub struct Outputs {
     pub mcap: Option<McapSink>,
     pub vtk: Option<VtkSink>,
     /// `--pool-csv`: the melt pool's time series beside the MCAP.
-    pub pool_csv: Option<crate::output::pool_csv::PoolCsv>,
+    pub pool_csv: Option<pool_csv::PoolCsv>,
     pub checkpoints: Option<CheckpointSink>,
     /// Simulated time between periodic checkpoints; None writes them only at the end,
     /// on interruption and on an instability stop.

@@ -28,8 +28,8 @@
 //!   from the bottom up and ends at the first gap wider than 1.5Δx, so a droplet
 //!   flying above the surface does not count as surface.
 
-use crate::diagnostics::PoolFigures;
 use crate::model::Model;
+use crate::pool::PoolFigures;
 use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;

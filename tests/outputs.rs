@@ -452,7 +452,7 @@ fn heat_fields_and_diagnostics_reach_the_mcap() {
     // its plot.
     let csv = std::fs::read_to_string(dir.join("s.pool.csv")).unwrap();
     let mut rows = csv.lines();
-    assert_eq!(rows.next(), Some(spatter::output::pool_csv::HEADER));
+    assert_eq!(rows.next(), Some(spatter::run::pool_csv::HEADER));
     let n = rows.clone().count();
     assert!(rows.all(|r| r.split(',').count() == 10), "{csv}");
     let png = dir.join("pool.png");

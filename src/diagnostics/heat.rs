@@ -3,6 +3,7 @@
 //! melt pool.
 
 use crate::model::Model;
+use crate::pool::{melt_regions, PoolFigures};
 use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
@@ -96,76 +97,17 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
             d.melted_volume += fl as f64 * cell;
         }
     }
-    PoolFigures::of(m, st, &crate::pool::melt_regions(m, st), None).write(&mut d);
+    set_pool(&mut d, &PoolFigures::of(m, st, &melt_regions(m, st), None));
     Some(d)
 }
 
-/// The melt pool's figures at one state (`/diagnostics`, crate::pool).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct PoolFigures {
-    pub depth: f64,
-    pub width: f64,
-    pub length: f64,
-    pub volume: f64,
-    pub detached_regions: u64,
-    pub detached_particles: u64,
-    pub detached_mass: f64,
-}
-
-impl PoolFigures {
-    /// From the state's melt regions; `depth` below the initial surface where
-    /// the caller knows it (the track), else the pool's height.
-    pub fn of(
-        m: &Model,
-        st: &State,
-        r: &crate::pool::MeltRegions,
-        depth: Option<f64>,
-    ) -> PoolFigures {
-        let mut f = PoolFigures {
-            detached_regions: r.detached_regions as u64,
-            detached_particles: r.detached_particles as u64,
-            detached_mass: r.detached_mass,
-            ..PoolFigures::default()
-        };
-        if let Some(e) = PoolExtent::of(m, st, &r.pool) {
-            let up = m.dim as usize - 1;
-            f.length = e.size(0, m.dx);
-            f.width = if m.dim == 3 { e.size(1, m.dx) } else { 0.0 };
-            f.depth = depth.unwrap_or(e.size(up, m.dx));
-            f.volume = r.pool.len() as f64 * m.dx.powi(m.dim as i32);
-        }
-        f
-    }
-    pub fn write(&self, h: &mut HeatDiagnostics) {
-        h.pool_depth = self.depth;
-        h.pool_width = self.width;
-        h.pool_length = self.length;
-        h.pool_volume = self.volume;
-        h.detached_melt_regions = self.detached_regions;
-        h.detached_melt_particles = self.detached_particles;
-        h.detached_melt_mass = self.detached_mass;
-    }
-}
-
-/// The bounding box of a set of particles (world coordinates).
-pub struct PoolExtent(pub [[f64; 2]; 3]);
-
-impl PoolExtent {
-    pub fn of(m: &Model, st: &State, members: &[usize]) -> Option<PoolExtent> {
-        if members.is_empty() {
-            return None;
-        }
-        let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
-        for &i in members {
-            let x = m.to_world(st.pos[i]);
-            for a in 0..3 {
-                b[a] = [b[a][0].min(x[a]), b[a][1].max(x[a])];
-            }
-        }
-        Some(PoolExtent(b))
-    }
-    /// The extent along axis a, counting each particle as Δx wide.
-    pub fn size(&self, a: usize, dx: f64) -> f64 {
-        self.0[a][1] - self.0[a][0] + dx
-    }
+/// Write a state's pool figures into its heat record.
+pub fn set_pool(h: &mut HeatDiagnostics, f: &PoolFigures) {
+    h.pool_depth = f.depth;
+    h.pool_width = f.width;
+    h.pool_length = f.length;
+    h.pool_volume = f.volume;
+    h.detached_melt_regions = f.detached_regions;
+    h.detached_melt_particles = f.detached_particles;
+    h.detached_melt_mass = f.detached_mass;
 }

@@ -9,7 +9,6 @@
 
 pub mod mcap_out;
 pub mod pointcloud;
-pub mod pool_csv;
 pub mod vtk;
 
 use crate::model::Model;

@@ -189,7 +189,7 @@ impl Observer for TrackObserver {
     fn annotate(&self, d: &mut Diagnostics) {
         d.depression_depth = self.0.as_ref().and_then(Track::depression_now);
         if let (Some(t), Some(h)) = (self.0.as_ref(), d.heat.as_mut()) {
-            t.pool_now().write(h);
+            crate::diagnostics::set_pool(h, &t.pool_now());
         }
     }
     fn finish(

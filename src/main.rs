@@ -530,6 +530,9 @@ fn cmd_run(
         "steps: {}, simulated time: {:.6e} s",
         report.steps, report.sim_time
     );
+    if let Some(why) = &report.stop_reason {
+        println!("{why}");
+    }
     if let Some(h) = spatter::diagnostics::heat_diagnostics(&loaded.model, &report.final_state) {
         // 2D figures are per metre of depth.
         let (per, vol) = if loaded.model.dim == 2 {

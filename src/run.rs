@@ -162,6 +162,8 @@ pub struct RunReport {
     pub leakage: Leakage,
     /// The melt track of a laser scene (issue 16).
     pub track: Option<crate::track::TrackProfile>,
+    /// Why the run ended before its end time (`run.stop_when`).
+    pub stop_reason: Option<String>,
 }
 
 impl RunReport {
@@ -372,6 +374,7 @@ pub fn run(
     let mut steps_done = 0u64;
     let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
     let mut end = RunEnd::Completed;
+    let mut stop_reason = None;
     while trip.is_none() {
         let t = sim.time as f64;
         let (done, frac) = match opts.end {
@@ -437,6 +440,10 @@ pub fn run(
             out.checkpoint(m, &st).map_err(rt)?;
         }
         sched = OutputSchedule::new(m, t, out.checkpoint_every);
+        stop_reason = solidified(m, &st);
+        if stop_reason.is_some() {
+            break;
+        }
     }
     progress.finish();
     // The last chunk can end between two scans: the final state is scanned too, so
@@ -489,7 +496,33 @@ pub fn run(
         last_checkpoint: out.last_checkpoint.clone(),
         leakage: found.leakage,
         track: found.track,
+        stop_reason,
     })
+}
+
+/// `run.stop_when = "solidified"` (issue 29 item 5): why the run stops at the
+/// sample `st`, if it does: the beam is off for good and no melt is left, or the
+/// grace after the beam went off has passed.
+fn solidified(m: &Model, st: &State) -> Option<String> {
+    let (off, grace) = m.stop_when_solidified?;
+    let t = st.sim.time as f64;
+    if t < off {
+        return None;
+    }
+    let melt = (0..st.active())
+        .filter(|&i| crate::pool::is_melt(m, st, i))
+        .count();
+    if melt == 0 {
+        Some(format!(
+            "stopped at t = {t:.6e} s: the beam is off since {off:.6e} s and no melt is left (run.stop_when = \"solidified\")"
+        ))
+    } else if t >= off + grace {
+        Some(format!(
+            "stopped at t = {t:.6e} s: {grace:e} s after the beam went off (run.stop_grace), {melt} particle(s) still molten"
+        ))
+    } else {
+        None
+    }
 }
 
 /// Run `n` steps in small batches, stopping early if a signal arrived.

@@ -687,6 +687,19 @@ pub struct RunDef {
     /// Refuse a fixed `dt` above the F22 (42) limits (default true). Switching it off
     /// is for deliberately unstable runs, such as testing the watchdog.
     pub dt_check: Option<bool>,
+    /// "solidified": end a laser run at the first sample after the beam is off
+    /// for good with no melt left (liquid fraction ≥ ½), or `stop_grace`
+    /// seconds after the beam went off, whichever comes first (issue 29).
+    pub stop_when: Option<StopWhen>,
+    /// s after the beam goes off (default: none, only the melt's end stops it).
+    pub stop_grace: Option<f64>,
+}
+
+/// `run.stop_when`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopWhen {
+    Solidified,
 }
 
 /// Instability watchdog thresholds (issue 3). Densities are relative to each

@@ -447,3 +447,25 @@ fn contact_angle_per_phase() {
         );
     }
 }
+
+/// Issue 29: `validate` warns on surface tension with gas at a density ratio of
+/// 10 or more without F22's interface viscosity, naming F22's values; with it
+/// set, no such warning.
+#[test]
+fn tension_with_gas_and_no_interface_viscosity_warns() {
+    let sq = common::scene("square_drop_2d");
+    let warned = |sets: &[&str]| {
+        let mut args = vec!["validate", sq.as_str()];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let out = common::spatter(&args);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(0), "{o}{e}");
+        format!("{o}{e}").contains("simulation.interface_viscosity")
+    };
+    assert!(warned(&["materials.gas.density=10.0"]));
+    assert!(warned(&[]), "ratio 10");
+    assert!(!warned(&["simulation.interface_viscosity=7.2"]));
+    assert!(!warned(&["materials.gas.density=200.0"]), "ratio 5");
+}

@@ -379,3 +379,47 @@ fn peer_bench_scene_has_the_peer_particle_count() {
     let peer = format!("water (Liquid): {}", 47u64.pow(3));
     assert!(out.contains(&peer), "{out}");
 }
+
+/// Issue 29: every `--set` a scene header recommends is accepted by the scene
+/// (`validate`, exit 0): a documented override that ends in exit 2 is a defect.
+/// Each is tried alone, read from the header's comments (quoted or bare, across
+/// a line break).
+#[test]
+fn every_set_a_scene_header_recommends_is_accepted() {
+    let mut tried = 0;
+    for dir in ["validation", "pbf", "bench"] {
+        let root = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
+        for entry in std::fs::read_dir(&root).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            // The comments of the file as one line.
+            let comments: Vec<&str> = text
+                .lines()
+                .filter_map(|l| l.split_once('#').map(|(_, c)| c.trim()))
+                .collect();
+            let joined = comments.join(" ");
+            let mut rest = joined.as_str();
+            while let Some(k) = rest.find("--set") {
+                rest = rest[k + 5..].trim_start();
+                let value = if let Some(q) = rest.strip_prefix('\'') {
+                    let end = q.find('\'').expect("closing quote");
+                    let v = &q[..end];
+                    rest = &q[end + 1..];
+                    v.to_string()
+                } else {
+                    let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+                    let v = rest[..end].trim_end_matches([')', '`', ',', '.', ';']);
+                    let v = v.trim_start_matches('`');
+                    rest = &rest[end..];
+                    v.to_string()
+                };
+                let p = path.to_str().unwrap();
+                let out = common::spatter(&["validate", p, "--set", &value]);
+                let (o, e) = common::text(&out);
+                assert_eq!(out.status.code(), Some(0), "{p}: --set {value}: {o}{e}");
+                tried += 1;
+            }
+        }
+    }
+    assert!(tried >= 10, "{tried} recommended overrides found");
+}

@@ -125,6 +125,9 @@ pub struct Model {
     pub end: EndCondition,
     pub output_interval: f64,
     pub diagnostics_interval: f64,
+    /// `run.stop_when = "solidified"`: (the time the beam goes off for good,
+    /// the grace after it: ∞ without `run.stop_grace`).
+    pub stop_when_solidified: Option<(f64, f64)>,
     pub check: Option<CheckDef>,
     pub watchdog: WatchdogDef,
     pub laser: Option<Laser>,
@@ -554,7 +557,11 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             }
         }
     }
+    if let Some(w) = dispersion_risk(file, sim, &phases, surface_tension.as_ref()) {
+        warnings.push(w);
+    }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
+    let stop_when_solidified = stop_when(&cx, run, laser.as_ref(), &phases)?;
     let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
     let delta = delta_coefficient(&cx, sim)?;
     if delta.is_some() && sim.pressure_floor {
@@ -629,6 +636,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         end,
         output_interval,
         diagnostics_interval,
+        stop_when_solidified,
         check: scene.check.clone(),
         watchdog: scene.watchdog.clone(),
         laser,
@@ -679,6 +687,65 @@ fn delta_coefficient(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Option<
         )),
         (_, None) => Ok(None),
     }
+}
+
+/// `run.stop_when = "solidified"` (issue 29 item 5): a laser scene with a
+/// melting phase whose power table ends at 0 W; (beam off from, grace).
+fn stop_when(
+    cx: &Ctx,
+    run: &crate::scene::RunDef,
+    laser: Option<&laser::Laser>,
+    phases: &[PhaseInfo],
+) -> Result<Option<(f64, f64)>, InputError> {
+    let grace = match run.stop_grace {
+        Some(g) => cx.positive("run.stop_grace", g)?,
+        None => f64::INFINITY,
+    };
+    let Some(crate::scene::StopWhen::Solidified) = run.stop_when else {
+        if run.stop_grace.is_some() {
+            return Err(cx.err("run.stop_grace", "needs run.stop_when = \"solidified\""));
+        }
+        return Ok(None);
+    };
+    let melts = phases
+        .iter()
+        .any(|p| p.thermal.and_then(|t| t.melting).is_some());
+    let Some(l) = laser.filter(|_| melts) else {
+        return Err(cx.err(
+            "run.stop_when",
+            "\"solidified\" needs a [laser] and a phase that melts",
+        ));
+    };
+    match l.power.last() {
+        Some(&(t_off, p)) if p == 0.0 => Ok(Some((t_off, grace))),
+        _ => Err(cx.err(
+            "run.stop_when",
+            "\"solidified\": the beam never turns off (laser.power must end with a [time, 0.0] point)",
+        )),
+    }
+}
+
+/// Issue 29: surface tension with gas at a density ratio of 10 or more and no
+/// liquid–gas interface viscosity: such a drop disperses into its gas within a
+/// few oscillations (measured at ratio 100: square_drop_2d with its viscosities
+/// cut, 14 of 256 particles alone in the gas by 0.28 s); F22 damps the
+/// interface with α^lg (Table 1, molten steel: 7.2; Table 4, binder: 1.8).
+fn dispersion_risk(
+    file: &str,
+    sim: &crate::scene::Simulation,
+    phases: &[PhaseInfo],
+    tension: Option<&tension::SurfaceTension>,
+) -> Option<String> {
+    let t = tension?;
+    let ratio = phases[t.liquid].rho0 / phases[t.gas?].rho0;
+    (ratio >= 10.0 && sim.interface_viscosity == 0.0).then(|| {
+        format!(
+            "{file}: key `simulation.interface_viscosity`: surface tension with gas at a density \
+             ratio of {ratio:.0} and no liquid-gas interface viscosity: the liquid can disperse \
+             into its gas (the watchdog stops such a run, watchdog.on_dispersion); F22 uses \
+             7.2 for molten steel (Table 1) and 1.8 for a liquid binder (Table 4)"
+        )
+    })
 }
 
 /// `[powder]`: the grains' phase (solid or wall), a box inside the domain, then

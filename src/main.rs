@@ -363,7 +363,7 @@ fn cmd_sweep(
         let dir_abs = std::fs::canonicalize(dir).map_err(|e| rt(e.to_string()))?;
         spatter::output::write_atomic(
             &script,
-            sweep::slurm_script(&dir_abs, &exe, manifest.cells.len()).as_bytes(),
+            sweep::slurm_script(&dir_abs, &exe, manifest.cells.len(), backend).as_bytes(),
         )
         .map_err(rt)?;
         println!(
@@ -536,7 +536,7 @@ fn cmd_run(
     if let Some(h) = spatter::diagnostics::heat_diagnostics(&loaded.model, &report.final_state) {
         // 2D figures are per metre of depth.
         let (per, vol) = if loaded.model.dim == 2 {
-            ("/m", "m^2/m")
+            ("/m", "m^2")
         } else {
             ("", "m^3")
         };

@@ -726,8 +726,10 @@ pub struct WatchdogDef {
     /// splash sheds droplets of several particles.
     pub liquid_dispersion: f64,
     /// What a dispersing liquid does to the run: "stop" (exit 3 with the
-    /// diagnosis, the default) or "warn" (a warning per sample).
-    pub on_dispersion: DispersionAction,
+    /// diagnosis) or "warn" (a warning per sample). Default: "stop", "warn"
+    /// in scenes with a phase that melts, where a melt pool's single-particle
+    /// spatter counts too (Model::dispersion_action).
+    pub on_dispersion: Option<DispersionAction>,
 }
 
 /// `watchdog.on_dispersion`.
@@ -748,7 +750,7 @@ impl Default for WatchdogDef {
             min_dt_ratio: 1e-3,
             wall_penetration: None,
             liquid_dispersion: 0.05,
-            on_dispersion: DispersionAction::Stop,
+            on_dispersion: None,
         }
     }
 }

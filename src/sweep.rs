@@ -7,7 +7,9 @@
 //!   overrides and folder DIR/cell_NNN). Each cell runs `spatter run SCENE
 //!   --set ... --out cell/run.mcap --summary cell/figures.json` as a child
 //!   process (its log in cell/run.log) and leaves cell/summary.json (overrides,
-//!   exit code, figures). A rerun skips every cell that has a summary.json.
+//!   exit code, figures). A rerun skips every cell whose summary records a
+//!   finished run (completed, or stopped unstable) and runs the others again
+//!   (interrupted, killed, failed to start).
 //! - `--slurm`: writes the manifest and DIR/sweep.slurm, a job array whose task
 //!   i runs `spatter sweep cell DIR i`: the very command a local sweep runs per
 //!   cell, so a cluster and a workstation produce the same folders.
@@ -100,28 +102,42 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, String> {
 }
 
 /// The Slurm job-array script of a sweep: task i runs cell i.
-pub fn slurm_script(dir: &Path, exe: &Path, cells: usize) -> String {
+pub fn slurm_script(dir: &Path, exe: &Path, cells: usize, backend: &str) -> String {
+    let gpus = if backend == "cpu" {
+        ""
+    } else {
+        "#SBATCH --gpus=1\n"
+    };
     format!(
         "#!/bin/bash\n\
          # spatter sweep: one array task per cell of {dir}/manifest.json.\n\
          # Submit with: sbatch {dir}/sweep.slurm ; then: spatter sweep collect {dir}\n\
          #SBATCH --job-name=spatter-sweep\n\
          #SBATCH --array=0-{last}\n\
-         #SBATCH --output={dir}/slurm_%a.log\n\
+         #SBATCH --output=\"{dir}/slurm_%a.log\"\n\
          #SBATCH --ntasks=1\n\
-         #SBATCH --gpus=1\n\
+         {gpus}\
          set -euo pipefail\n\
          export XDG_RUNTIME_DIR=\"${{XDG_RUNTIME_DIR:-$(mktemp -d)}}\"\n\
-         {exe} sweep cell {dir} \"$SLURM_ARRAY_TASK_ID\"\n",
+         \"{exe}\" sweep cell \"{dir}\" \"$SLURM_ARRAY_TASK_ID\"\n",
         dir = dir.display(),
         exe = exe.display(),
         last = cells.saturating_sub(1),
     )
 }
 
-/// A cell that has its summary.json is done.
+/// A cell is done when its summary.json says the run completed or stopped
+/// unstable (exit 0, 1 for a failed check, 3); an interrupted, killed or
+/// failed-to-start run is run again.
 pub fn done(dir: &Path, c: &Cell) -> bool {
-    dir.join(&c.folder).join("summary.json").exists()
+    finished(&dir.join(&c.folder).join("summary.json")).is_some()
+}
+
+/// The summary at `path` if it records a finished run.
+fn finished(path: &Path) -> Option<CellSummary> {
+    let s: CellSummary = serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
+    let end = s.figures.as_ref()?.get("end")?.as_str()?;
+    (matches!(s.exit_code, Some(0 | 1 | 3)) && matches!(end, "completed" | "unstable")).then_some(s)
 }
 
 /// What a cell leaves in summary.json.
@@ -143,10 +159,8 @@ pub fn run_cell(dir: &Path, index: usize, exe: &Path) -> Result<CellSummary, Str
         .ok_or_else(|| format!("{}: no cell {index} (of {})", dir.display(), m.cells.len()))?;
     let folder = dir.join(&c.folder);
     let summary_path = folder.join("summary.json");
-    if let Ok(text) = std::fs::read_to_string(&summary_path) {
-        if let Ok(s) = serde_json::from_str(&text) {
-            return Ok(s);
-        }
+    if let Some(s) = finished(&summary_path) {
+        return Ok(s);
     }
     std::fs::create_dir_all(&folder)
         .map_err(|e| format!("{}: cannot create: {e}", folder.display()))?;
@@ -222,9 +236,14 @@ pub fn run_local(dir: &Path, jobs: usize, exe: &Path) -> Result<Vec<CellSummary>
     if let Some(e) = errors.first() {
         return Err(e.clone());
     }
+    // Every cell's summary, as it ended (one that did not finish says how).
     m.cells
         .iter()
-        .map(|c| run_cell(dir, c.index, exe))
+        .map(|c| {
+            let p = dir.join(&c.folder).join("summary.json");
+            let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))
+        })
         .collect()
 }
 

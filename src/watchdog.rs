@@ -87,7 +87,7 @@ pub fn scan(m: &Model, st: &State) -> Option<Trip> {
         }
     }
     let Some((id, field, value, reason)) = worst else {
-        return match m.watchdog.on_dispersion {
+        return match m.dispersion_action() {
             DispersionAction::Stop => dispersion_trip(m, st),
             DispersionAction::Warn => None,
         };
@@ -402,7 +402,7 @@ mod tests {
         m.watchdog.liquid_dispersion = 0.06;
         assert_eq!(scan(&m, &st), None);
         m.watchdog.liquid_dispersion = 0.05;
-        m.watchdog.on_dispersion = DispersionAction::Warn;
+        m.watchdog.on_dispersion = Some(DispersionAction::Warn);
         assert_eq!(scan(&m, &st), None);
         assert!(dispersion(&m, &st).unwrap().beyond(&m));
     }

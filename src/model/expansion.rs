@@ -264,7 +264,14 @@ fn temperature_program(
     // T stays positive over the run (end_time, or the ramp's end).
     let horizon = scene.run.end_time.unwrap_or(until).min(until);
     let peak_amplitude = if amplitude_rate > 0.0 {
-        amplitude + amplitude_rate * scene.run.end_time.unwrap_or(f64::INFINITY)
+        let Some(end) = scene.run.end_time else {
+            return Err(cx.err(
+                &k("amplitude_rate"),
+                "needs run.end_time (the amplitude grows over the run: the temperature must \
+                 stay above 0 K to its end)",
+            ));
+        };
+        amplitude + amplitude_rate * end
     } else {
         amplitude
     };

@@ -201,6 +201,20 @@ fn heat_integration(
 pub const MAX_PHASES: usize = 8;
 
 impl Model {
+    /// `watchdog.on_dispersion`, or its default: "warn" where a phase melts (a
+    /// melt pool under gas sheds single-particle spatter), "stop" elsewhere.
+    pub fn dispersion_action(&self) -> crate::scene::DispersionAction {
+        use crate::scene::DispersionAction;
+        let melts = self
+            .phases
+            .iter()
+            .any(|p| p.thermal.and_then(|t| t.melting).is_some());
+        match (self.watchdog.on_dispersion, melts) {
+            (Some(a), _) => a,
+            (None, true) => DispersionAction::Warn,
+            (None, false) => DispersionAction::Stop,
+        }
+    }
     pub fn max_sound_speed(&self) -> f64 {
         self.phases
             .iter()

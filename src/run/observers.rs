@@ -63,7 +63,10 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     if crate::track::wanted(m) {
         list.push(Box::new(TrackObserver(None)));
     }
-    if m.watchdog.on_dispersion == crate::scene::DispersionAction::Warn && !opts.quiet {
+    if m.watchdog.enabled
+        && m.dispersion_action() == crate::scene::DispersionAction::Warn
+        && !opts.quiet
+    {
         list.push(Box::new(DispersionWarning));
     }
     list

@@ -40,14 +40,17 @@ pub trait Observer {
     fn annotate(&self, _d: &mut Diagnostics) {}
     /// Conclude from the state the run ends on (`last`, already observed), into
     /// `found`; an observer with a topic of its own writes it to `out` (still open).
+    /// An observer that only warns concludes nothing.
     fn finish(
         self: Box<Self>,
-        m: &Model,
-        last: &State,
-        end: &RunEnd,
-        out: &mut Outputs,
-        found: &mut Findings,
-    ) -> Result<(), String>;
+        _m: &Model,
+        _last: &State,
+        _end: &RunEnd,
+        _out: &mut Outputs,
+        _found: &mut Findings,
+    ) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// The observers of a run of `m`, in the order they see each state.
@@ -89,16 +92,6 @@ impl Observer for DispersionWarning {
                 d.describe(m)
             );
         }
-    }
-    fn finish(
-        self: Box<Self>,
-        _m: &Model,
-        _last: &State,
-        _end: &RunEnd,
-        _out: &mut Outputs,
-        _found: &mut Findings,
-    ) -> Result<(), String> {
-        Ok(())
     }
 }
 

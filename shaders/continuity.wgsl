@@ -1,4 +1,4 @@
-// uses: params consts kernel grid phase rigid
+// uses: params consts kernel grid phase rigid math
 // reads: pos vel mass phase id body bodies sim heat
 // writes: rho press continuity density_gradient
 // δ-SPH density (R18 §3.1.2, (3.14) with the diffusion (3.53) and its
@@ -86,27 +86,7 @@ fn continuity_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
             b.z = b.z + db * d.z;
         }
     }
-    var g = vec3<f32>(0.0);
-    if (P.sizes.dim == 2u) {
-        let det = mxx * myy - mxy * mxy;
-        if (abs(det) > 1.0e-3) {
-            g.x = (myy * b.x - mxy * b.y) / det;
-            g.y = (mxx * b.y - mxy * b.x) / det;
-        }
-    } else {
-        let c00 = myy * mzz - myz * myz;
-        let c01 = mxz * myz - mxy * mzz;
-        let c02 = mxy * myz - mxz * myy;
-        let c11 = mxx * mzz - mxz * mxz;
-        let c12 = mxy * mxz - mxx * myz;
-        let c22 = mxx * myy - mxy * mxy;
-        let det = mxx * c00 + mxy * c01 + mxz * c02;
-        if (abs(det) > 1.0e-3) {
-            g.x = (c00 * b.x + c01 * b.y + c02 * b.z) / det;
-            g.y = (c01 * b.x + c11 * b.y + c12 * b.z) / det;
-            g.z = (c02 * b.x + c12 * b.y + c22 * b.z) / det;
-        }
-    }
+    let g = solve_symmetric(mxx, mxy, mxz, myy, myz, mzz, b);
     density_gradient[i] = vec4<f32>(g, 0.0);
 }
 

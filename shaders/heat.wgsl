@@ -1,6 +1,6 @@
 // uses: params consts kernel grid phase math vapour
 // reads: pos rho mass id surface sim
-// writes: acc acc_b heat phase vel body heat_start solvers partials
+// writes: acc acc_b heat phase vel body heat_start solvers partials solidification
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
@@ -306,10 +306,18 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         let t = programmed_temperature(ph, sim.time + sim.dt);
         hv[H_ENTHALPY] = P.phases[ph].heat_capacity * (t - P.phases[ph].reference_temperature);
     }
+    let t_prev = hv[H_TEMPERATURE];
     let tf = temperature_of(ph, hv[H_ENTHALPY]);
     hv[H_TEMPERATURE] = tf.x;
     hv[H_LIQUID] = tf.y;
     heat[i] = hv;
+    if ((P.sizes.flags & FLAG_SOLIDIFICATION) != 0u && (flags & HEAT_MELTS) != 0u) {
+        var t_start = t_prev;
+        if (P.solve.heat_integrator == HEAT_TRAPEZOIDAL) {
+            t_start = temperature_of(ph, heat_start[i].x).x;
+        }
+        record_liquidus_crossing(i, ph, t_start, tf.x, hv[H_RATE]);
+    }
     // Phase change at f_l = 1/2 (F22 §3.2, fixed substrate).
     let switch_to = (flags >> HEAT_SWITCH_SHIFT) & 15u;
     if (switch_to == 0u) { return; }
@@ -326,4 +334,79 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             body[id[i]] = BODY_SOLIDIFIED;
         }
     }
+}
+
+// The solidification record (issue 29; twin of record_crossing in
+// src/backend/cpu/heat.rs): a melting particle whose temperature falls through
+// the liquidus in this step (t_start >= T_l > t_new) records the crossing's
+// time (linear in T within the step), its position and the cooling rate
+// -dh/dt / c_l (the liquid side's, at the step's rate), and leaves its |grad T|
+// pending for solidification_gradient. t_start is the step's first
+// temperature (the trapezoidal iterates overwrote heat.y: T(h^n) then).
+fn record_liquidus_crossing(i: u32, ph: u32, t_start: f32, t_new: f32, rate: f32) {
+    let t_l = P.phases[ph].liquidus;
+    if (t_start < t_l || t_new >= t_l) { return; }
+    let k = id[i];
+    var a = solidification[k];
+    a[SOL_TIME] = sim.time + sim.dt * ((t_start - t_l) / (t_start - t_new));
+    a[SOL_GRADIENT] = -c_one();
+    a[SOL_COOLING] = -rate / P.phases[ph].liquid_heat_capacity;
+    a[SOL_COUNT] = a[SOL_COUNT] + c_one();
+    solidification[k] = a;
+    let p = pos[i];
+    solidification[P.sizes.n_particles + k] = vec4<f32>(p.x, p.y, p.z, c_one());
+}
+
+// |grad T| of each particle whose liquidus crossing in this step left it
+// pending, once every temperature of the step is final. Twin of
+// solidification_gradient in src/backend/cpu/heat.rs (equations there).
+@compute @workgroup_size(64)
+fn solidification_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let at = P.sizes.n_particles + id[i];
+    var b = solidification[at];
+    if (b[SOL_PENDING] == 0.0) { return; }
+    let g = temperature_gradient(i);
+    var a = solidification[id[i]];
+    a[SOL_GRADIENT] = sqrt(len2(g));
+    solidification[id[i]] = a;
+    b[SOL_PENDING] = 0.0;
+    solidification[at] = b;
+}
+
+// The renormalised temperature gradient M^-1 sum_j V_j (T_j - T_i) grad_i W_ij
+// over conducting neighbours and Dirichlet walls (at their mirror temperatures).
+fn temperature_gradient(i: u32) -> vec3<f32> {
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    let t_i = heat[i][H_TEMPERATURE];
+    var mxx = 0.0;
+    var mxy = 0.0;
+    var mxz = 0.0;
+    var myy = 0.0;
+    var myz = 0.0;
+    var mzz = 0.0;
+    var b = vec3<f32>(0.0);
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        let ph_j = phase[j];
+        if (r2 < P.kernel.support2 && r2 > 0.0 && (conducts(ph_j) || (heat_flags(ph_j) & HEAT_DIRICHLET) != 0u)) {
+            let r = sqrt(r2);
+            let vf = mass[j] / heat_density(ph_j, j) * (kernel_dw(r) / r);
+            mxx = mxx - vf * d.x * d.x;
+            mxy = mxy - vf * d.x * d.y;
+            mxz = mxz - vf * d.x * d.z;
+            myy = myy - vf * d.y * d.y;
+            myz = myz - vf * d.y * d.z;
+            mzz = mzz - vf * d.z * d.z;
+            let db = (heat[j][H_TEMPERATURE] - t_i) * vf;
+            b.x = b.x + db * d.x;
+            b.y = b.y + db * d.y;
+            b.z = b.z + db * d.z;
+        }
+    }
+    return solve_symmetric(mxx, mxy, mxz, myy, myz, mzz, b);
 }

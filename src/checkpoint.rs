@@ -61,6 +61,9 @@ pub struct Header {
     /// δ-SPH: the continuity array follows (and the density is state).
     #[serde(default)]
     pub continuity: bool,
+    /// A phase melts: the solidification record (2n × 4 f32, by id) follows.
+    #[serde(default)]
+    pub solidification: bool,
     /// Entries of each table (crate::fields::TABLES), stored after the particle
     /// arrays in registry order; a table not named here is empty.
     #[serde(default)]
@@ -93,6 +96,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         bodies: !st.body.is_empty(),
         heat_start: !st.heat_start.is_empty(),
         continuity: !st.continuity.is_empty(),
+        solidification: !st.solidification.is_empty(),
         tables: TABLES
             .iter()
             .map(|t| (t.name.to_string(), t.entries(st) as u64))
@@ -174,6 +178,7 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         implicit_heat: header.heat_start,
         solvers: false, // a table, not a particle array
         continuity: header.continuity,
+        solidification: header.solidification,
     };
     let mut state = State::default();
     for f in FIELDS.iter().filter(|f| f.checkpointed) {

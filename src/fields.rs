@@ -31,6 +31,8 @@ pub enum Holder {
     Solvers,
     /// The δ-SPH formulation (continuity density: ρ is state, sorted).
     Continuity,
+    /// Scenes with a phase that melts (the solidification record).
+    Solidification,
 }
 
 /// The scene's holders, from the pipeline's features.
@@ -42,6 +44,7 @@ pub struct Held {
     pub implicit_heat: bool,
     pub solvers: bool,
     pub continuity: bool,
+    pub solidification: bool,
 }
 
 impl Held {
@@ -54,6 +57,7 @@ impl Held {
             Holder::ImplicitHeat => self.implicit_heat,
             Holder::Solvers => self.solvers,
             Holder::Continuity => self.continuity,
+            Holder::Solidification => self.solidification,
         }
     }
     /// What a state holds (its optional arrays are empty when not held).
@@ -65,6 +69,7 @@ impl Held {
             implicit_heat: !st.heat_start.is_empty(),
             solvers: !st.solvers.is_empty(),
             continuity: !st.continuity.is_empty(),
+            solidification: !st.solidification.is_empty(),
         }
     }
     /// What a scene holds, from its model (the same as its schedule's features:
@@ -80,6 +85,7 @@ impl Held {
             // The trapezoidal heat is the only repeat so far.
             solvers: implicit_heat,
             continuity: m.formulation == crate::scene::Formulation::DeltaWcsph,
+            solidification: m.melts(),
         }
     }
 }
@@ -170,7 +176,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 16] = [
+pub const FIELDS: [FieldDef; 17] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -210,6 +216,11 @@ pub const FIELDS: [FieldDef; 16] = [
     // Written by heat.begin every step after the sort (no scratch needed).
     field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
         None),
+    // Indexed by particle id, not sorted: the last liquidus crossing on cooling
+    // (time, G, cooling rate, count; position, pending), written by
+    // heat.temperature when it happens.
+    field!("solidification", solidification, "solidification", None, 4, 2, true,
+        Holder::Solidification, Some(output::solidification_channels)),
 ];
 
 /// The state's arrays that are not per particle: one row each, read the same way

@@ -24,6 +24,7 @@ pub mod random;
 pub mod run;
 pub mod scene;
 pub mod setup;
+pub mod solidification;
 pub mod state;
 pub mod sweep;
 pub mod track;

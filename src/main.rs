@@ -549,11 +549,7 @@ fn cmd_run(
             h.radiated_power,
             h.melted_volume,
         );
-        let melts = loaded
-            .model
-            .phases
-            .iter()
-            .any(|p| p.thermal.and_then(|t| t.melting).is_some());
+        let melts = loaded.model.melts();
         // Laser scenes print the track's pool figures below instead.
         if melts && report.track.is_none() {
             println!(
@@ -572,6 +568,9 @@ fn cmd_run(
         for line in t.summary(loaded.model.dim) {
             println!("{line}");
         }
+    }
+    if let Some(s) = &report.solidification {
+        println!("{}", s.line());
     }
     if !report.final_state.bodies.is_empty() {
         let tally = spatter::bodies::BodyTally::of(&report.final_state);

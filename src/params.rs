@@ -48,6 +48,10 @@ pub const FLAG_MARRONE_VISCOSITY: u32 = 16384;
 /// δ-SPH with the density diffusion on the raw ρ across phases
 /// (`simulation.density_diffusion = "raw"`, R18 Test 4's incompatible variant).
 pub const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768;
+/// A phase melts (and the scene has heat): the temperature pass records each
+/// particle's liquidus crossing on cooling and the `solidification_gradient`
+/// dispatch its |∇T| (`State::solidification`, issue 29).
+pub const FLAG_SOLIDIFICATION: u32 = 65536;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -794,6 +798,9 @@ fn scene_flags(m: &Model) -> u32 {
     }
     if m.needs_interface() {
         flags |= FLAG_INTERFACE;
+    }
+    if m.melts() {
+        flags |= FLAG_SOLIDIFICATION;
     }
     flags
 }

@@ -88,6 +88,36 @@ pub fn pow(x: f32, y: f32) -> f32 {
     exp(y * ln(x))
 }
 
+/// M g = b for the symmetric M = (xx, xy, xz, yy, yz, zz), by cofactors (the
+/// 2×2 block in 2D); 0 where |det M| ≤ 1e-3. The renormalised gradients
+/// (continuity's density, the solidification record's temperature). Twin of
+/// `solve_symmetric` in shaders/lib/math.wgsl.
+pub fn solve_symmetric(dim: u32, m: [f32; 6], b: [f32; 3]) -> [f32; 3] {
+    let [xx, xy, xz, yy, yz, zz] = m;
+    let mut g = [0.0f32; 3];
+    if dim == 2 {
+        let det = xx * yy - xy * xy;
+        if det.abs() > 1.0e-3 {
+            g[0] = (yy * b[0] - xy * b[1]) / det;
+            g[1] = (xx * b[1] - xy * b[0]) / det;
+        }
+        return g;
+    }
+    let c00 = yy * zz - yz * yz;
+    let c01 = xz * yz - xy * zz;
+    let c02 = xy * yz - xz * yy;
+    let c11 = xx * zz - xz * xz;
+    let c12 = xy * xz - xx * yz;
+    let c22 = xx * yy - xy * xy;
+    let det = xx * c00 + xy * c01 + xz * c02;
+    if det.abs() > 1.0e-3 {
+        g[0] = (c00 * b[0] + c01 * b[1] + c02 * b[2]) / det;
+        g[1] = (c01 * b[0] + c11 * b[1] + c12 * b[2]) / det;
+        g[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det;
+    }
+    g
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

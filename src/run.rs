@@ -1,6 +1,6 @@
 //! Loading a scene, choosing a backend and driving the step loop.
 
-mod observers;
+pub(crate) mod observers;
 pub mod pool_csv;
 
 use observers::observe_all;
@@ -101,10 +101,12 @@ pub fn load_checkpoint(path: &str, sets: &[String]) -> Result<Loaded, InputError
             "checkpoint phases do not match its scenario",
         ));
     }
-    Ok(Loaded {
-        model,
-        state: ck.state,
-    })
+    let mut state = ck.state;
+    if model.melts() && state.solidification.is_empty() {
+        // A checkpoint written before the solidification record existed.
+        state.solidification = setup::unrecorded_solidification(state.len());
+    }
+    Ok(Loaded { model, state })
 }
 
 pub fn make_backend(
@@ -164,6 +166,8 @@ pub struct RunReport {
     pub track: Option<crate::track::TrackProfile>,
     /// Why the run ended before its end time (`run.stop_when`).
     pub stop_reason: Option<String>,
+    /// Where and how the metal froze, in scenes with a melting phase (issue 29).
+    pub solidification: Option<crate::solidification::Summary>,
 }
 
 impl RunReport {
@@ -485,6 +489,7 @@ pub fn run(
     }
     out.finish().map_err(rt)?;
     let wall_s = start.elapsed().as_secs_f64();
+    let solidification = crate::solidification::Summary::of(m, &final_state);
     Ok(RunReport {
         steps: final_state.sim.step as u64 - start_step,
         sim_time: final_state.sim.time as f64,
@@ -497,6 +502,7 @@ pub fn run(
         leakage: found.leakage,
         track: found.track,
         stop_reason,
+        solidification,
     })
 }
 

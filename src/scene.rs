@@ -819,6 +819,9 @@ pub enum CheckKind {
     /// One-phase Stefan problem: melting front s(t) = 2λ√(α t).
     #[serde(rename = "stefan_1d")]
     Stefan1d,
+    /// Two-phase Stefan (Neumann) solidification from a cold wall: the
+    /// solidification record's G and R against the front's gradient and speed.
+    SolidificationFront,
     /// Energy balance with a laser: enthalpy gained = ζ ∫P dt − energy lost
     /// through Dirichlet walls (none in an insulated scene).
     LaserEnergy,
@@ -881,6 +884,7 @@ impl CheckKind {
             CheckKind::ConductionTwoMaterials => "conduction_two_materials",
             CheckKind::Adiabatic => "adiabatic",
             CheckKind::Stefan1d => "stefan_1d",
+            CheckKind::SolidificationFront => "solidification_front",
             CheckKind::LaserEnergy => "laser_energy",
             CheckKind::Rosenthal => "rosenthal",
             CheckKind::Compression => "compression",

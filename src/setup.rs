@@ -356,10 +356,23 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         st.continuity = vec![[0.0, 1.0]; st.len()];
         st.density_gradient = vec![[0.0; 4]; st.len()];
     }
+    if held.solidification {
+        st.solidification = unrecorded_solidification(st.len());
+    }
     if held.solvers {
         st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];
     }
     Ok(st)
+}
+
+/// The solidification record before any crossing: no time (−1), no gradient,
+/// no count; nothing pending.
+pub fn unrecorded_solidification(n: usize) -> Vec<[f32; 4]> {
+    let mut v = vec![[0.0; 4]; 2 * n];
+    for r in &mut v[..n] {
+        r[crate::state::SOL_TIME] = -1.0;
+    }
+    v
 }
 
 /// Hydrostatic start: each fluid particle begins at the pressure of the fluid

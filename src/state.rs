@@ -81,6 +81,13 @@ pub struct State {
     /// solver slot (backend::schedule::SOLVER_SLOTS), this step's iterations,
     /// flag and residual.
     pub solvers: Vec<Solver>,
+    /// Scenes with a phase that melts, and heat (empty otherwise), 2n entries
+    /// indexed by particle id (`solidification[id]`, `solidification[n + id]`),
+    /// not sorted: the record of the particle's last liquidus crossing on cooling
+    /// (issue 29). First (time of the crossing, |∇T| there (K/m; −1 until the
+    /// gradient dispatch has computed it), cooling rate −dT/dt (K/s), crossings so
+    /// far); then (position xyz at the crossing, 1 while the gradient is pending).
+    pub solidification: Vec<[f32; 4]>,
     pub sim: Sim,
 }
 
@@ -108,6 +115,13 @@ pub const S_DELTA: usize = 3;
 pub const S_SHEPARD: usize = 0;
 pub const S_CURVATURE: usize = 1;
 pub const S_RAW_CURVATURE: usize = 2;
+/// `solidification[id]` is (time, G, cooling rate, crossings);
+/// `solidification[n + id]` is (position xyz, gradient pending).
+pub const SOL_TIME: usize = 0;
+pub const SOL_GRADIENT: usize = 1;
+pub const SOL_COOLING: usize = 2;
+pub const SOL_COUNT: usize = 3;
+pub const SOL_PENDING: usize = 3;
 
 /// `State::body` of a particle that belongs to no body.
 pub const NO_BODY: u32 = u32::MAX;

@@ -373,6 +373,7 @@ fn flag_and_code_constants_match() {
         ("FLAG_FREE_SURFACE_TENSION", rs::FLAG_FREE_SURFACE_TENSION),
         ("FLAG_WETTING", rs::FLAG_WETTING),
         ("FLAG_BODIES", rs::FLAG_BODIES),
+        ("FLAG_SOLIDIFICATION", rs::FLAG_SOLIDIFICATION),
         ("FLAG_CONTINUITY", rs::FLAG_CONTINUITY),
         ("FLAG_MARRONE_VISCOSITY", rs::FLAG_MARRONE_VISCOSITY),
         ("NO_BODY", spatter::state::NO_BODY),
@@ -406,6 +407,11 @@ fn flag_and_code_constants_match() {
         ("S_SHEPARD", st::S_SHEPARD),
         ("S_CURVATURE", st::S_CURVATURE),
         ("S_RAW_CURVATURE", st::S_RAW_CURVATURE),
+        ("SOL_TIME", st::SOL_TIME),
+        ("SOL_GRADIENT", st::SOL_GRADIENT),
+        ("SOL_COOLING", st::SOL_COOLING),
+        ("SOL_COUNT", st::SOL_COUNT),
+        ("SOL_PENDING", st::SOL_PENDING),
     ];
     for (name, v) in slots {
         assert_eq!(value(name), v as u32, "{name}");

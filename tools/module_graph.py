@@ -26,11 +26,13 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src")
 # Each remaining cycle, as the sorted tuple of its modules, with why it stays
 # (ARCHITECTURE.md, "Module boundaries", says the same).
 EXPLAINED = {
-    ("fields", "output", "state"): (
+    ("fields", "output", "solidification", "state"): (
         "the field registry lists State's arrays (state.rs iterates it for the "
         "compared fields) and names each field's frame channels, which output's "
         "frame builder iterates: one table over three files, so a field is "
-        "declared once"
+        "declared once; the solidification record's channels carry R, which "
+        "solidification.rs derives from the records around each particle (it "
+        "reads State and nothing above it)"
     ),
     ("kernel", "params"): (
         "kernel.rs, the CPU twin of lib/kernel.wgsl, reads the f32 parameter "

@@ -17,11 +17,19 @@ Commands:
     spatter_read.py track RUN.mcap OUT.png       laser track: remelt depth and surface height along x,
                                                  and a cross-section of the last frame (2D: the x-z
                                                  plane; 3D: y-z through the track's middle)
+    spatter_read.py solidification RUN.mcap OUT.png [--cet A,N,N0]
+                                                 solidification map: G against R of every liquidus
+                                                 crossing (/solidification) with the columnar-to-
+                                                 equiaxed transition of Gaumann et al. (2001) for
+                                                 CMSX-4 (A = 1.25e6 K^3.4/(m s), N = 3.4, N0 = 2e15
+                                                 m^-3; --cet gives another alloy's), and the cooling
+                                                 rate G R along x
 
 As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
 (time, {field: numpy array}) of the particles still in the simulation;
 info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
-speed, mass); info["track"] is the /track message of a laser scene (None
+speed, mass); info["solidification"] the /solidification records as columns
+(t, x, y, z, gradient, solidification_rate, cooling_rate, ...: numpy arrays); info["track"] is the /track message of a laser scene (None
 without); info["bodies"] the /bodies messages of a scene with rigid bodies (one
 per frame: time, and per body its position, orientation, velocity, angular
 velocity, mass, particles, molten_fraction, bonded); read_vtu(path) -> {field: numpy array}.
@@ -95,6 +103,7 @@ def _messages(path):
 def read_mcap(path):
     frames, diagnostics, removed = [], [], []
     info = {"schemas": {}, "metadata": {}, "track": None, "bodies": []}
+    batches = []
     for schema, channel, message, decoded in _messages(path):
         info["schemas"][channel.topic] = schema.name if schema else ""
         if channel.topic == "/particles":
@@ -107,7 +116,12 @@ def read_mcap(path):
             info["track"] = decoded
         elif channel.topic == "/bodies":
             info["bodies"].append(decoded)
+        elif channel.topic == "/solidification":
+            batches.append(decoded)
     info["removed"] = sorted(removed, key=lambda r: (r["time"], r["id"]))
+    columns = [k for k in (batches[0] if batches else {}) if k != "time"]
+    info["solidification"] = {k: np.concatenate([np.asarray(b[k], dtype=float) for b in batches])
+                              for k in columns}
     info["complete"] = is_complete(path)
     info["metadata"] = read_metadata(path)
     return frames, diagnostics, info
@@ -288,6 +302,57 @@ def track(path, png):
     fig.savefig(png, dpi=100)
 
 
+# Gaumann, Bezencon, Canalis & Kurz, Acta Mater. 49 (2001) 1051, for CMSX-4:
+# the dendrite tip undercooling dT = (a V)^(1/n) and the heterogeneous
+# nucleation density N0. Hunt's limits of the equiaxed volume fraction phi:
+# fully columnar below 0.0066, fully equiaxed above 0.49.
+CET_CMSX4 = (1.25e6, 3.4, 2.0e15)
+
+
+def cet_gradient(v, phi, a, n, n0):
+    """G on the CET line at solidification rate v (m/s) for equiaxed fraction phi:
+    G^n / V = a [(-4 pi N0 / (3 ln(1 - phi)))^(1/3) / (n + 1)]^n."""
+    k = (-4.0 * np.pi * n0 / (3.0 * np.log(1.0 - phi))) ** (1.0 / 3.0) / (n + 1.0)
+    return (a * v) ** (1.0 / n) * k
+
+
+def solidification(path, png, cet=CET_CMSX4):
+    """G-R map with the CET lines, and the cooling rate along x."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    _, _, info = read_mcap(path)
+    s = info["solidification"]
+    if not s or len(s["t"]) == 0:
+        raise SystemExit(f"{path}: no /solidification records (no phase melts, or nothing froze from the liquid)")
+    ok = (s["gradient"] > 0) & (s["solidification_rate"] > 0)
+    g, r, t = s["gradient"][ok], s["solidification_rate"][ok], s["t"][ok]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.8))
+    sc = a.scatter(r, g, c=t * 1e3, s=6, cmap="viridis")
+    fig.colorbar(sc, ax=a, label="liquidus crossing time (ms)")
+    a.set_xscale("log")
+    a.set_yscale("log")
+    if len(r):
+        v = np.logspace(np.log10(r.min()) - 1, np.log10(r.max()) + 1, 100)
+        for phi, style, label in ((0.0066, "-", "columnar above"), (0.49, "--", "equiaxed below")):
+            a.plot(v, cet_gradient(v, phi, *cet), "k" + style, label=f"CET, phi = {phi} ({label})")
+        a.set_xlim(v[0], v[-1])
+    a.set_xlabel("solidification rate R (m/s)")
+    a.set_ylabel("thermal gradient G (K/m)")
+    a.set_title(f"{ok.sum()} liquidus crossings; CET: a = {cet[0]:.3g}, n = {cet[1]}, N0 = {cet[2]:.3g}")
+    a.legend(fontsize=8, loc="lower right")
+    cool = s["cooling_rate"][ok]
+    b.scatter(s["x"][ok] * 1e6, cool, s=6, c=t * 1e3, cmap="viridis")
+    b.set_yscale("log")
+    b.set_xlabel("x at the crossing (µm)")
+    b.set_ylabel("cooling rate G R (K/s)")
+    b.set_title("cooling rate along the track")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    print(f"{png}: {ok.sum()} records, median G {np.median(g):.3e} K/m, R {np.median(r):.3e} m/s, "
+          f"cooling {np.median(cool):.3e} K/s")
+
+
 def export_last(path, directory):
     frames, _, _ = read_mcap(path)
     if not frames:
@@ -329,6 +394,11 @@ def main(argv):
         pool(path, argv[3])
     elif cmd == "track" and len(argv) == 4:
         track(path, argv[3])
+    elif cmd == "solidification" and len(argv) in (4, 6) and (len(argv) == 4 or argv[4] == "--cet"):
+        cet = tuple(float(v) for v in argv[5].split(",")) if len(argv) == 6 else CET_CMSX4
+        if len(cet) != 3:
+            raise SystemExit("--cet takes A,N,N0")
+        solidification(path, argv[3], cet)
     elif cmd == "export-last" and len(argv) == 4:
         export_last(path, argv[3])
     elif cmd == "compare-vtk" and len(argv) == 4:

@@ -68,3 +68,33 @@ fn pm_sin_cycles(x: f32) -> f32 {
     let p = P.consts.sin_c0 + z * (P.consts.sin_c1 + z * (P.consts.sin_c2 + z * (P.consts.sin_c3 + z * P.consts.sin_c4)));
     return th + th * (z * p);
 }
+
+// M g = b for a symmetric M = (xx, xy, xz, yy, yz, zz) by cofactors (the 2x2
+// block in 2D); 0 where |det M| <= 1e-3 (M is about the identity for a full
+// kernel support: too few neighbours). The renormalised gradients (continuity's
+// density, the solidification record's temperature). Twin of solve_symmetric in
+// src/portable_math.rs.
+fn solve_symmetric(xx: f32, xy: f32, xz: f32, yy: f32, yz: f32, zz: f32, b: vec3<f32>) -> vec3<f32> {
+    var g = vec3<f32>(0.0);
+    if (P.sizes.dim == 2u) {
+        let det = xx * yy - xy * xy;
+        if (abs(det) > 1.0e-3) {
+            g.x = (yy * b.x - xy * b.y) / det;
+            g.y = (xx * b.y - xy * b.x) / det;
+        }
+        return g;
+    }
+    let c00 = yy * zz - yz * yz;
+    let c01 = xz * yz - xy * zz;
+    let c02 = xy * yz - xz * yy;
+    let c11 = xx * zz - xz * xz;
+    let c12 = xy * xz - xx * yz;
+    let c22 = xx * yy - xy * xy;
+    let det = xx * c00 + xy * c01 + xz * c02;
+    if (abs(det) > 1.0e-3) {
+        g.x = (c00 * b.x + c01 * b.y + c02 * b.z) / det;
+        g.y = (c01 * b.x + c11 * b.y + c12 * b.z) / det;
+        g.z = (c02 * b.x + c12 * b.y + c22 * b.z) / det;
+    }
+    return g;
+}

@@ -270,6 +270,7 @@ const FLAG_BODIES: u32 = 4096u;
 const FLAG_CONTINUITY: u32 = 8192u;
 const FLAG_MARRONE_VISCOSITY: u32 = 16384u;
 const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768u;
+const FLAG_SOLIDIFICATION: u32 = 65536u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;
@@ -303,6 +304,13 @@ const S_DELTA: u32 = 3u;
 const S_SHEPARD: u32 = 0u;
 const S_CURVATURE: u32 = 1u;
 const S_RAW_CURVATURE: u32 = 2u;
+// solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
+// (position xyz, gradient pending): the last liquidus crossing on cooling.
+const SOL_TIME: u32 = 0u;
+const SOL_GRADIENT: u32 = 1u;
+const SOL_COOLING: u32 = 2u;
+const SOL_COUNT: u32 = 3u;
+const SOL_PENDING: u32 = 3u;
 // Time-step limit codes (sim.dt_limit; src/model/limits.rs).
 const DT_ACOUSTIC: u32 = 0u;
 const DT_VISCOUS: u32 = 1u;

@@ -6,8 +6,8 @@
 use super::cpu::CpuBackend;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT,
-    FLAG_INTERFACE, FLAG_RECOIL, FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL,
-    LASER_BEER_LAMBERT, LASER_SURFACE,
+    FLAG_INTERFACE, FLAG_RECOIL, FLAG_SOLIDIFICATION, FLAG_SURFACE_TENSION, FLAG_WETTING,
+    HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -37,7 +37,8 @@ pub enum Stage {
     Laser,
     /// Conduction dh/dt, surface losses and the explicit Euler enthalpy update.
     Heat,
-    /// T and liquid fraction from the enthalpy; phase switches.
+    /// T and liquid fraction from the enthalpy; phase switches; liquidus
+    /// crossings on cooling recorded, then their |∇T|.
     Temperature,
     /// Second half kick and the mushy-zone sink.
     Kick,
@@ -94,6 +95,8 @@ pub struct Features {
     pub implicit_heat: bool,
     /// δ-SPH: the density is continuity state (R18 §3.1.2).
     pub continuity: bool,
+    /// A phase melts: liquidus crossings on cooling are recorded with |∇T|.
+    pub solidification: bool,
 }
 
 impl Features {
@@ -118,6 +121,7 @@ impl Features {
             implicit_heat: params.flag(FLAG_HEAT)
                 && params.solve.heat_integrator == HEAT_TRAPEZOIDAL,
             continuity: params.flag(FLAG_CONTINUITY),
+            solidification: params.flag(FLAG_SOLIDIFICATION),
         }
     }
 }
@@ -386,7 +390,15 @@ pub const STAGES: [StageDef; 20] = [
         name: "heat.temperature",
         file: "heat",
         needed: |f| f.heat,
-        dispatches: &[always("temperature", Work::Particles, |b| b.temperature())],
+        dispatches: &[
+            always("temperature", Work::Particles, |b| b.temperature()),
+            when(
+                "solidification_gradient",
+                Work::Particles,
+                |f| f.solidification,
+                |b| b.solidification_gradient(),
+            ),
+        ],
     },
     StageDef {
         stage: Stage::KickDrift,

@@ -229,6 +229,7 @@ impl Pipeline {
             implicit_heat: f.implicit_heat,
             solvers: self.has_solvers(),
             continuity: f.continuity,
+            solidification: f.solidification,
         }
     }
     /// Leave `stage` out of every later step (bench throughput).

@@ -251,6 +251,17 @@ pub const SWEEPS: &[Sweep] = &[
         quick: true,
     },
     Sweep {
+        name: "solidification_1d",
+        text: scene_text!("solidification_1d"),
+        sets: &[],
+        length: 0.01,
+        // Periodic in x: at least 9 Δx across.
+        cells: &[10, 16, 20],
+        expected_order: Some(1.0),
+        why: "R is a gradient of crossing times that advance one particle row at a time",
+        quick: false,
+    },
+    Sweep {
         name: "rosenthal_2d",
         text: scene_text!("rosenthal_2d"),
         sets: &[],

@@ -79,6 +79,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/settling_disc_2d"), &["dx=0.02"]),
     (scene_file!("validation/square_drop_2d"), &["dx=4e-3"]),
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),
+    (scene_file!("validation/solidification_1d"), &[]),
     (scene_file!("validation/sinking_blob_2d"), &["dx=0.04"]),
     (scene_file!("validation/thermal_cycle_drop_2d"), &["dx=0.1"]),
     (

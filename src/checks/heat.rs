@@ -22,7 +22,7 @@ fn conducting(m: &Model, st: &State) -> Vec<(f64, f64, usize)> {
 }
 
 /// Prescribed temperatures of the Dirichlet walls below and above the domain.
-fn wall_temperatures(m: &Model, st: &State) -> (Option<f64>, Option<f64>) {
+pub(super) fn wall_temperatures(m: &Model, st: &State) -> (Option<f64>, Option<f64>) {
     let ax = m.dim as usize - 1;
     let (mut lo, mut hi) = (None, None);
     for i in 0..st.len() {

@@ -18,6 +18,7 @@ mod expansion;
 mod flow;
 mod heat;
 mod noise;
+mod solidification;
 mod tension;
 pub mod thermocapillary;
 mod two_layer;
@@ -143,6 +144,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         }),
         CheckKind::Adiabatic => Box::new(heat::Adiabatic::default()),
         CheckKind::Stefan1d => Box::new(heat::Stefan::default()),
+        CheckKind::SolidificationFront => Box::new(solidification::Front),
         CheckKind::Rosenthal => Box::new(heat::Rosenthal),
         CheckKind::LaserEnergy => Box::new(heat::LaserEnergy::default()),
         CheckKind::Restitution => Box::new(bodies::Restitution),

@@ -28,6 +28,7 @@ pub const BODIES_TOPIC: &str = "/bodies";
 
 /// The JSON topics of a scene's MCAP stream, in channel order: `/diagnostics`
 /// and `/removed` always, `/track` in scenes with a melt track (crate::track),
+/// `/solidification` in scenes with a melting phase (crate::solidification),
 /// `/bodies` in scenes with rigid bodies.
 pub fn topics(m: &Model) -> Vec<JsonTopic> {
     let mut t = vec![
@@ -47,6 +48,13 @@ pub fn topics(m: &Model) -> Vec<JsonTopic> {
             topic: TRACK_TOPIC,
             schema_name: "spatter.Track",
             schema: track_schema(),
+        });
+    }
+    if m.melts() {
+        t.push(JsonTopic {
+            topic: crate::solidification::SOLIDIFICATION_TOPIC,
+            schema_name: "spatter.Solidification",
+            schema: crate::solidification::schema(),
         });
     }
     if m.has_bodies() {

@@ -205,11 +205,7 @@ impl Model {
     /// melt pool under gas sheds single-particle spatter), "stop" elsewhere.
     pub fn dispersion_action(&self) -> crate::scene::DispersionAction {
         use crate::scene::DispersionAction;
-        let melts = self
-            .phases
-            .iter()
-            .any(|p| p.thermal.and_then(|t| t.melting).is_some());
-        match (self.watchdog.on_dispersion, melts) {
+        match (self.watchdog.on_dispersion, self.melts()) {
             (Some(a), _) => a,
             (None, true) => DispersionAction::Warn,
             (None, false) => DispersionAction::Stop,
@@ -287,6 +283,13 @@ impl Model {
     }
     pub fn is_thermal(&self) -> bool {
         self.phases.iter().any(|p| p.thermal.is_some())
+    }
+    /// A phase melts. The run then records where and how the metal solidifies
+    /// (`State::solidification`, `/solidification`).
+    pub fn melts(&self) -> bool {
+        self.phases
+            .iter()
+            .any(|p| p.thermal.and_then(|t| t.melting).is_some())
     }
     pub fn n_cells(&self) -> u64 {
         self.grid.iter().map(|&g| g as u64).product()

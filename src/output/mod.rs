@@ -110,6 +110,43 @@ pub fn body_channels(_m: &Model, st: &State) -> Vec<Field> {
     channel("body", Values::U32(body))
 }
 
+/// Frame channels (MCAP and VTK), per particle in frame order:
+/// `solidification_time` (s, −1 where the particle never froze from the
+/// liquid), `thermal_gradient` G (K/m), `cooling_rate` (K/s) and
+/// `solidification_rate` R (m/s), 0 where there is no record.
+pub fn solidification_channels(m: &Model, st: &State) -> Vec<Field> {
+    let mut by_id: Vec<Option<crate::solidification::Record>> = vec![None; st.solidification.len() / 2];
+    for r in crate::solidification::records(m, st) {
+        by_id[r.id as usize] = Some(r);
+    }
+    let recs: Vec<Option<crate::solidification::Record>> = st.id.iter().map(|&k| by_id[k as usize]).collect();
+    let col = |f: fn(&crate::solidification::Record) -> f64, none: f32| {
+        Values::F32(
+            recs.iter()
+                .map(|r| r.as_ref().map_or(none, |r| f(r) as f32))
+                .collect(),
+        )
+    };
+    vec![
+        Field {
+            name: "solidification_time",
+            values: col(|r| r.time, -1.0),
+        },
+        Field {
+            name: "thermal_gradient",
+            values: col(|r| r.gradient, 0.0),
+        },
+        Field {
+            name: "cooling_rate",
+            values: col(|r| r.cooling_rate, 0.0),
+        },
+        Field {
+            name: "solidification_rate",
+            values: col(|r| r.rate, 0.0),
+        },
+    ]
+}
+
 /// Position channels: world coordinates x, y, z (m), `Model::to_world` rounded
 /// once to f32.
 pub fn position_channels(m: &Model, st: &State) -> Vec<Field> {

@@ -7,6 +7,7 @@ use crate::checks::{CheckResult, Checker};
 use crate::diagnostics::{Diagnostics, Leakage, TRACK_TOPIC};
 use crate::model::Model;
 use crate::state::State;
+use crate::solidification;
 use crate::track::{Track, TrackProfile};
 
 /// Which state an observer is shown.
@@ -65,6 +66,9 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     }
     if crate::track::wanted(m) {
         list.push(Box::new(TrackObserver(None)));
+    }
+    if m.melts() {
+        list.push(Box::<SolidificationRecords>::default());
     }
     if m.watchdog.enabled
         && m.dispersion_action() == crate::scene::DispersionAction::Warn
@@ -204,6 +208,72 @@ impl Observer for TrackObserver {
             sink.message(TRACK_TOPIC, last.sim.time as f64, &profile)?;
         }
         found.track = Some(profile);
+        Ok(())
+    }
+}
+
+/// The observer that turns the device's records into `/solidification`
+/// messages: at each state read back, the records whose crossing count changed;
+/// at the end, R of each from every record seen, one message per sample.
+#[derive(Default)]
+struct SolidificationRecords {
+    /// Crossings seen per particle id.
+    seen: Vec<u32>,
+    /// (sample time, records new at it).
+    samples: Vec<(f64, Vec<solidification::Record>)>,
+}
+
+impl SolidificationRecords {
+    /// The records new in `st` since the last state taken in.
+    fn take(&mut self, m: &Model, st: &State) -> Vec<solidification::Record> {
+        let n = st.solidification.len() / 2;
+        self.seen.resize(n, 0);
+        let mut new = Vec::new();
+        for k in 0..n {
+            let Some(r) = crate::solidification::raw_record(m, st, k) else {
+                continue;
+            };
+            if r.crossings != self.seen[k] {
+                self.seen[k] = r.crossings;
+                new.push(r);
+            }
+        }
+        new
+    }
+}
+
+impl Observer for SolidificationRecords {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        let new = self.take(m, st);
+        // The initial state's records (a resumed run's) are not new.
+        if when != Moment::Initial && !new.is_empty() {
+            self.samples.push((st.sim.time as f64, new));
+        }
+    }
+    fn finish(
+        self: Box<Self>,
+        m: &Model,
+        _last: &State,
+        _end: &RunEnd,
+        out: &mut Outputs,
+        _found: &mut Findings,
+    ) -> Result<(), String> {
+        let Some(sink) = out.mcap.as_mut() else {
+            return Ok(());
+        };
+        let sizes: Vec<usize> = self.samples.iter().map(|s| s.1.len()).collect();
+        let all: Vec<solidification::Record> = self.samples.iter().flat_map(|s| s.1.clone()).collect();
+        let mut all = solidification::with_front_speeds(m, all).into_iter();
+        for ((time, _), size) in self.samples.iter().zip(sizes) {
+            let mut batch = solidification::Batch {
+                time: *time,
+                ..solidification::Batch::default()
+            };
+            for r in all.by_ref().take(size) {
+                batch.push(&r);
+            }
+            sink.message(solidification::SOLIDIFICATION_TOPIC, *time, &batch)?;
+        }
         Ok(())
     }
 }

@@ -27,11 +27,13 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_INTERFACE, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, KIND_SOLID,
+    Params, FLAG_BODIES, FLAG_INTERFACE, FLAG_SOLIDIFICATION, HEAT_DIRICHLET, HEAT_LIQUID,
+    HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
 use crate::state::{Solver, State, BODY_SOLIDIFIED};
 use crate::state::{H_ENTHALPY, H_LIQUID, H_RATE, H_TEMPERATURE, S_DELTA};
+use crate::state::{SOL_COOLING, SOL_COUNT, SOL_GRADIENT, SOL_PENDING, SOL_TIME};
 use rayon::prelude::*;
 
 /// Density a particle's volume and heat capacity use: summation density for
@@ -359,10 +361,14 @@ fn impose_program(pr: &Params, ph: u32, now: f32, hv: &mut [f32; 4]) {
 /// liquid whose liquid fraction falls below ½ becomes its solid phase, frozen in
 /// place (velocity and accelerations zeroed). With rigid bodies, a particle that
 /// solidified is marked `BODY_SOLIDIFIED` for `bodies.melt`, which bonds the
-/// bodies it touches.
+/// bodies it touches. With a melting phase, a liquidus crossing on cooling is
+/// recorded (`record_crossing`).
 pub fn temperature(pr: &Params, st: &mut State) {
     let n = st.active();
     let now = st.sim.time + st.sim.dt;
+    let (time, dt) = (st.sim.time, st.sim.dt);
+    let trapezoidal = pr.solve.heat_integrator == HEAT_TRAPEZOIDAL;
+    let records = pr.flag(FLAG_SOLIDIFICATION);
     let State {
         heat,
         phase,
@@ -371,10 +377,14 @@ pub fn temperature(pr: &Params, st: &mut State) {
         acc_b,
         body,
         id,
+        pos,
+        heat_start,
+        solidification,
         ..
     } = st;
     let bodies = pr.flag(FLAG_BODIES);
-    heat[..n]
+    let heat_start: &[[f32; 4]] = heat_start;
+    let found: Vec<(usize, Found)> = heat[..n]
         .par_iter_mut()
         .zip(phase[..n].par_iter_mut())
         .zip(
@@ -390,26 +400,131 @@ pub fn temperature(pr: &Params, st: &mut State) {
             if pr.programmed(*ph) {
                 impose_program(pr, *ph, now, hv);
             }
+            let t_prev = hv[H_TEMPERATURE];
             let (t, fl) = temperature_of(pr, *ph, hv[H_ENTHALPY]);
             hv[H_TEMPERATURE] = t;
             hv[H_LIQUID] = fl;
-            let target = pr.switch_target(*ph)?;
-            let solid = pr.phases[*ph as usize].kind == KIND_SOLID;
-            if solid && fl >= 0.5 {
-                *ph = target;
-            } else if !solid && fl < 0.5 {
-                *ph = target;
-                *v = [0.0; 4];
-                *a = [0.0; 4];
-                *ab = [0.0; 4];
-                // Only rigid-body scenes need to know (bodies.melt).
-                return bodies.then_some(i);
+            let mut f = Found::default();
+            if records && pr.heat_flags(*ph) & HEAT_MELTS != 0 {
+                let t_start = if trapezoidal {
+                    temperature_of(pr, *ph, heat_start[i][0]).0
+                } else {
+                    t_prev
+                };
+                let t_l = pr.phases[*ph as usize].liquidus;
+                if !(t_start < t_l || t >= t_l) {
+                    f.crossing = Some(Crossing {
+                        time: time + dt * ((t_start - t_l) / (t_start - t)),
+                        cooling: -hv[H_RATE] / pr.phases[*ph as usize].liquid_heat_capacity,
+                    });
+                }
             }
-            None
+            if let Some(target) = pr.switch_target(*ph) {
+                let solid = pr.phases[*ph as usize].kind == KIND_SOLID;
+                if solid && fl >= 0.5 {
+                    *ph = target;
+                } else if !solid && fl < 0.5 {
+                    *ph = target;
+                    *v = [0.0; 4];
+                    *a = [0.0; 4];
+                    *ab = [0.0; 4];
+                    // Only rigid-body scenes need to know (bodies.melt).
+                    f.solidified = bodies;
+                }
+            }
+            (f.solidified || f.crossing.is_some()).then_some((i, f))
         })
-        .collect::<Vec<usize>>()
-        .into_iter()
-        .for_each(|i| body[id[i] as usize] = BODY_SOLIDIFIED);
+        .collect();
+    let total = solidification.len() / 2;
+    for (i, f) in found {
+        let k = id[i] as usize;
+        if f.solidified {
+            body[k] = BODY_SOLIDIFIED;
+        }
+        if let Some(c) = f.crossing {
+            record_crossing(&mut solidification[k], c);
+            let p = pos[i];
+            solidification[total + k] = [p[0], p[1], p[2], 1.0];
+        }
+    }
+}
+
+/// What `temperature` found for a particle that changes arrays indexed by id
+/// (written after the parallel sweep).
+#[derive(Default)]
+struct Found {
+    /// Solidified in a rigid-body scene: `bodies.melt` bonds what it touches.
+    solidified: bool,
+    crossing: Option<Crossing>,
+}
+
+/// A liquidus crossing on cooling in this step (issue 29's solidification
+/// record; twin of record_liquidus_crossing in shaders/heat.wgsl): t_start ≥ T_l
+/// > T at the step's end, t_start the step's first temperature (the trapezoidal
+/// iterates overwrote heat.y: T(h^n) then). The time is linear in T within the
+/// step, the cooling rate −(dh/dt)/c_l the liquid side's at the step's rate.
+struct Crossing {
+    time: f32,
+    cooling: f32,
+}
+
+/// (time, |∇T| pending (−1), cooling rate, crossings + 1).
+fn record_crossing(r: &mut [f32; 4], c: Crossing) {
+    r[SOL_TIME] = c.time;
+    r[SOL_GRADIENT] = -1.0;
+    r[SOL_COOLING] = c.cooling;
+    r[SOL_COUNT] += 1.0;
+}
+
+/// `solidification_gradient`: |∇T| of each particle whose liquidus crossing in
+/// this step left it pending, once every temperature of the step is final, by
+/// the renormalised gradient (first-order consistent at a free surface too)
+///   ∇T_i = M_i⁻¹ Σ_j V_j (T_j − T_i) ∇_iW_ij,  M_i = Σ_j V_j (r_j − r_i) ⊗ ∇_iW_ij,
+/// over conducting neighbours and Dirichlet walls (their mirror temperatures),
+/// V_j = m_j/ρ_j as in the conduction; 0 where M is near singular (a particle
+/// with too few neighbours: a lone droplet).
+pub fn solidification_gradient(pr: &Params, st: &mut State, grid: &CellTable) {
+    let total = st.solidification.len() / 2;
+    let s: &State = st;
+    let out: Vec<(usize, f32)> = (0..s.active())
+        .into_par_iter()
+        .filter_map(|i| {
+            let k = s.id[i] as usize;
+            if s.solidification[total + k][SOL_PENDING] == 0.0 {
+                return None;
+            }
+            let g = temperature_gradient(pr, s, grid, i);
+            Some((k, (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt()))
+        })
+        .collect();
+    for (k, g) in out {
+        st.solidification[k][SOL_GRADIENT] = g;
+        st.solidification[total + k][SOL_PENDING] = 0.0;
+    }
+}
+
+fn temperature_gradient(pr: &Params, s: &State, grid: &CellTable, i: usize) -> [f32; 3] {
+    let t_i = s.heat[i][H_TEMPERATURE];
+    let (mut m, mut b) = ([0.0f32; 6], [0.0f32; 3]);
+    for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+        let ph_j = s.phase[j];
+        if r2 <= 0.0 || !(pr.conducts(ph_j) || pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0) {
+            return;
+        }
+        let r = r2.sqrt();
+        let vf = s.mass[j] / heat_density(pr, &s.rho, ph_j, j) * (kernel::dw(pr, r) / r);
+        m[0] -= vf * d[0] * d[0];
+        m[1] -= vf * d[0] * d[1];
+        m[2] -= vf * d[0] * d[2];
+        m[3] -= vf * d[1] * d[1];
+        m[4] -= vf * d[1] * d[2];
+        m[5] -= vf * d[2] * d[2];
+        let db = (s.heat[j][H_TEMPERATURE] - t_i) * vf;
+        for a in 0..3 {
+            b[a] += db * d[a];
+        }
+    });
+    crate::portable_math::solve_symmetric(pr.sizes.dim, m, b)
 }
 
 #[cfg(test)]

@@ -152,6 +152,9 @@ impl CpuBackend {
     pub(crate) fn temperature(&mut self) {
         heat::temperature(&self.params, &mut self.st)
     }
+    pub(crate) fn solidification_gradient(&mut self) {
+        heat::solidification_gradient(&self.params, &mut self.st, &self.grid)
+    }
     pub(crate) fn kick(&mut self) {
         integrate::kick(&self.params, &mut self.st)
     }

@@ -144,7 +144,8 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
 // Free-surface form, first dispatch, R18 (3.28)-(3.29): raw Morris curvature
 // over the liquid's particles with a normal, weights V delta (V = m / rho0),
 // capped at |kappa| <= 1/support; to surface[n + i][S_RAW_CURVATURE] (the Shepard pass zeroed
-// it for everyone else).
+// it for everyone else). With thin_layer_rows (R18 4.4), S_THIN = 1 where no
+// liquid particle lies thin_layer_depth or deeper along -n.
 @compute @workgroup_size(64)
 fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
@@ -158,11 +159,15 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     let zr = z_range();
     var num = 0.0;
     var den = 0.0;
+    var deep = false;
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
         let r2 = len2(d);
         if (r2 < P.kernel.support2) {
             let s_j = surface[j];
+            if (phase[j] == liquid && d.x * s_i.x + d.y * s_i.y + d.z * s_i.z >= P.tension.thin_layer_depth) {
+                deep = true;
+            }
             if (phase[j] == liquid && s_j[S_DELTA] != 0.0) {
                 let r = sqrt(r2);
                 let fv = tension_ramp(tension_temperature(j)) * (mass[j] / P.phases[liquid].rho0) * s_j[S_DELTA];
@@ -179,6 +184,9 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         kappa = -(num / den);
     }
     surface[n + i][S_RAW_CURVATURE] = min(max(kappa, -P.tension.kappa_max), P.tension.kappa_max);
+    if (P.tension.thin_layer_depth > 0.0 && !deep) {
+        surface[n + i][S_THIN] = c_one();
+    }
 }
 
 // Free-surface form, second dispatch: the curvature smoothed, R18 (3.30), the
@@ -232,6 +240,8 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         gt = vec3<f32>(gt.x / shepard, gt.y / shepard, gt.z / shepard);
     }
     surface[n + i][S_CURVATURE] = kappa;
+    // R18 4.4: none on a layer of thin_layer_rows particles or fewer.
+    if (surface[n + i][S_THIN] != 0.0) { return; }
     var a = acc[i];
     a = vec4<f32>(a.xyz + tension_force(s_i, t_i, kappa, gt, P.phases[liquid].rho0), a.w);
     acc[i] = a;

@@ -205,6 +205,10 @@ gpu_struct! {
         pub sahoo_k_a: f32,
         pub sahoo_q: f32,
         pub sahoo_gamma_h: f32,
+        /// R18 §4.4: a free-surface particle with no liquid particle at least
+        /// this deep along −n is on a thin layer and gets no tension
+        /// ((rows − ½) Δx; 0: off).
+        pub thin_layer_depth: f32,
     }
 }
 
@@ -667,6 +671,9 @@ impl Params {
                     p.sizes.flags |= FLAG_FREE_SURFACE_TENSION;
                     t.gas = NO_PHASE;
                     t.kappa_max = (1.0 / m.support) as f32;
+                    if s.thin_layer_rows > 0 {
+                        t.thin_layer_depth = ((s.thin_layer_rows as f64 - 0.5) * m.dx) as f32;
+                    }
                 }
             }
         }

@@ -293,6 +293,11 @@ pub struct SurfaceTensionDef {
     /// One number for all of them, or a table naming every wall and solid phase
     /// (`{ substrate = 60.0, wall = 90.0 }`). Absent: no wetting model.
     pub contact_angle: Option<ContactAngleDef>,
+    /// R18 §4.4's rule for thin films (free-surface form): no tension on a
+    /// liquid surface particle whose liquid, along its normal, is at most this
+    /// many particles thick (R18: 2): their normal and curvature come from a
+    /// support that holds one or two rows. Absent or 0: tension everywhere.
+    pub thin_layer_rows: Option<u32>,
 }
 
 /// `surface_tension.sahoo`: the surface-active solute's term of R18 (4.2)

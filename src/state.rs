@@ -110,11 +110,13 @@ pub const H_TEMPERATURE: usize = 1;
 pub const H_LIQUID: usize = 2;
 pub const H_RATE: usize = 3;
 /// `surface[i]` is (outward normal xyz, surface delta δ); `surface[n + i]` is
-/// (Shepard sum Γ, curvature κ, the free-surface form's raw κ, unused).
+/// (Shepard sum Γ, curvature κ, the free-surface form's raw κ, thin-layer flag: R18 §4.4).
 pub const S_DELTA: usize = 3;
 pub const S_SHEPARD: usize = 0;
 pub const S_CURVATURE: usize = 1;
 pub const S_RAW_CURVATURE: usize = 2;
+/// Free-surface tension with `thin_layer_rows`: 1 on a thin layer's particle.
+pub const S_THIN: usize = 3;
 /// `solidification[id]` is (time, G, cooling rate, crossings);
 /// `solidification[n + id]` is (position xyz, gradient pending).
 pub const SOL_TIME: usize = 0;

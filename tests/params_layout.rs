@@ -407,6 +407,7 @@ fn flag_and_code_constants_match() {
         ("S_SHEPARD", st::S_SHEPARD),
         ("S_CURVATURE", st::S_CURVATURE),
         ("S_RAW_CURVATURE", st::S_RAW_CURVATURE),
+        ("S_THIN", st::S_THIN),
         ("SOL_TIME", st::SOL_TIME),
         ("SOL_GRADIENT", st::SOL_GRADIENT),
         ("SOL_COOLING", st::SOL_COOLING),

@@ -40,7 +40,7 @@ fn record_bit_matched_on_the_software_adapter() {
     let three_d = text
         .replace("dimension = 2", "dimension = 3")
         .replace("min = [0.0, 0.0]", "min = [0.0, 0.0, 0.0]")
-        .replace("max = [0.01, 0.08]", "max = [0.01, 0.03, 0.01]")
+        .replace("max = [0.01, 0.08]", "max = [0.01, 0.012, 0.01]")
         .replace("periodic = [true, false]", "periodic = [true, false, true]")
         .replace("open_sides = [\"y_max\"]", "open_sides = [\"y_max\"]");
     let trapezoidal = format!("{text}\n[heat]\nintegrator = \"trapezoidal\"\ntolerance = 1.0e-4\n");

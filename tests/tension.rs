@@ -469,3 +469,106 @@ fn tension_with_gas_and_no_interface_viscosity_warns() {
     assert!(!warned(&["simulation.interface_viscosity=7.2"]));
     assert!(!warned(&["materials.gas.density=200.0"]), "ratio 5");
 }
+
+/// A liquid film on a floor wall: 2 rows thick on the left, 6 on the right, in
+/// the free-surface form on δ-SPH.
+const FILM: &str = r#"
+[simulation]
+dimension = 2
+formulation = "delta_wcsph"
+kernel = "quintic"
+dx = 1.0e-3
+pressure_floor = false
+
+[domain]
+min = [0.0, 0.0]
+max = [0.06, 0.02]
+periodic = [true, false]
+wall_phase = "wall"
+open_sides = ["y_max"]
+
+[materials.liquid]
+density = 1000.0
+viscosity = 0.5
+reference_pressure = 1000.0
+
+[phases.liquid]
+kind = "liquid"
+material = "liquid"
+
+[phases.wall]
+kind = "wall"
+material = "liquid"
+
+[[shapes]]
+phase = "liquid"
+box = { min = [0.0, 0.0], max = [0.03, 0.002] }
+
+[[shapes]]
+phase = "liquid"
+box = { min = [0.03, 0.0], max = [0.06, 0.006] }
+
+[surface_tension]
+liquid = "liquid"
+coefficient = 0.1
+
+[run]
+end_time = 1.0
+"#;
+
+/// R18 §4.4's thin-film rule (`thin_layer_rows = 2`): the top row of the
+/// 2-row film is flagged and gets no tension force; the 6-row film's top row
+/// keeps it. Away from the step between them (one support) and the periodic seam.
+#[test]
+fn no_tension_on_a_film_of_two_rows() {
+    use spatter::backend::Backend;
+    use spatter::state::{S_DELTA, S_THIN};
+    let run = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let l = spatter::run::load_str("film", FILM, &sets).unwrap();
+        let params = spatter::params::Params::new(&l.model, l.state.len() as u32);
+        let mut cpu = spatter::backend::cpu::CpuBackend::new(params, l.state.clone());
+        // The prime computes the first accelerations: tension included.
+        cpu.prime();
+        (l.model, cpu.st)
+    };
+    let (m, on) = run(&["surface_tension.thin_layer_rows=2"]);
+    let (_, off) = run(&[]);
+    let n = on.len();
+    let (mut thin, mut thick) = (0, 0);
+    for i in 0..n {
+        let x = m.to_world(on.pos[i]);
+        let top_thin = (x[1] - 1.5e-3).abs() < 2e-4 && x[0] > 0.006 && x[0] < 0.024;
+        let top_thick = (x[1] - 5.5e-3).abs() < 2e-4 && x[0] > 0.036 && x[0] < 0.054;
+        if !(top_thin || top_thick) {
+            continue;
+        }
+        assert!(
+            on.surface[i][S_DELTA] > 0.0,
+            "a top-row particle has a surface delta"
+        );
+        let flagged = on.surface[n + i][S_THIN] != 0.0;
+        assert_eq!(flagged, top_thin, "particle at {x:?}");
+        assert_eq!(off.surface[n + i][S_THIN], 0.0);
+        if top_thin {
+            thin += 1;
+            // Without its force the film's top row keeps the forces sweep's
+            // acceleration only.
+            assert_ne!(on.acc[i], off.acc[i], "tension acts where not flagged");
+        } else {
+            thick += 1;
+            assert_eq!(on.acc[i], off.acc[i], "the thick film keeps its tension");
+        }
+    }
+    assert!(thin >= 15 && thick >= 15, "{thin} {thick}");
+    // Bad input: the gas form, and a support too short for the rows asked.
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene("laplace_disc_2d"),
+            "--set",
+            "surface_tension.thin_layer_rows=2",
+        ],
+        "surface_tension.thin_layer_rows",
+    );
+}

@@ -64,6 +64,7 @@ struct Tension {             // F22 (24)-(26), (8), (21)
     sahoo_k_a: f32,          // k_l a_s
     sahoo_q: f32,            // -dH0 / R
     sahoo_gamma_h: f32,      // Gamma_s dH0
+    thin_layer_depth: f32,   // R18 4.4: no tension without liquid this deep along -n (0: off)
 }
 
 struct Surfaces {
@@ -304,6 +305,7 @@ const S_DELTA: u32 = 3u;
 const S_SHEPARD: u32 = 0u;
 const S_CURVATURE: u32 = 1u;
 const S_RAW_CURVATURE: u32 = 2u;
+const S_THIN: u32 = 3u;
 // solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
 // (position xyz, gradient pending): the last liquidus crossing on cooling.
 const SOL_TIME: u32 = 0u;

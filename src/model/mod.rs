@@ -447,7 +447,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     let barrier = barrier_def(&cx, sim, h, dx)?;
     let powder = powder_bed(&cx, scene, dim, &phases)?;
     let (bodies, contact) = bodies::bodies(&cx, scene, &phases, dim, periodic, powder.as_ref())?;
-    let surface_tension = tension::surface_tension(&cx, scene, &phases)?;
+    let surface_tension = tension::surface_tension(&cx, scene, &phases, support, dx)?;
     let limits = DtLimits {
         acoustic: if c_max > 0.0 {
             0.25 * h / c_max

@@ -24,6 +24,9 @@ pub struct SurfaceTension {
     /// F22 (27)–(29) static contact angle (radians) per phase: Some for every
     /// wall and solid phase when the scene has wetting, None for the others.
     pub contact_angle: Option<Vec<Option<f64>>>,
+    /// R18 §4.4: no tension where the liquid under a surface particle is at most
+    /// this many rows thick (0: off; free-surface form only).
+    pub thin_layer_rows: u32,
 }
 
 /// R's gas constant, J/(mol K).
@@ -113,6 +116,8 @@ pub(super) fn surface_tension(
     cx: &Ctx,
     scene: &SceneFile,
     phases: &[PhaseInfo],
+    support: f64,
+    dx: f64,
 ) -> Result<Option<SurfaceTension>, InputError> {
     let Some(d) = &scene.surface_tension else {
         return Ok(None);
@@ -221,7 +226,9 @@ pub(super) fn surface_tension(
         None => None,
         Some(def) => Some(contact_angles(cx, def, phases, gas.is_some())?),
     };
+    let thin_layer_rows = thin_layer_rows(cx, d, gas.is_some(), support, dx)?;
     Ok(Some(SurfaceTension {
+        thin_layer_rows,
         contact_angle,
         liquid,
         gas,
@@ -232,6 +239,38 @@ pub(super) fn surface_tension(
         sahoo,
         ramp,
     }))
+}
+
+/// `surface_tension.thin_layer_rows`: free-surface form only, and the kernel's
+/// support must reach the row below the layer it tests for (rows + ½ spacings).
+fn thin_layer_rows(
+    cx: &Ctx,
+    d: &crate::scene::SurfaceTensionDef,
+    gas: bool,
+    support: f64,
+    dx: f64,
+) -> Result<u32, InputError> {
+    let key = "surface_tension.thin_layer_rows";
+    let rows = d.thin_layer_rows.unwrap_or(0);
+    if rows == 0 {
+        return Ok(0);
+    }
+    if gas {
+        return Err(cx.err(
+            key,
+            "applies to the free-surface form (no `gas`): F22's form with gas has no such rule",
+        ));
+    }
+    if support < (rows as f64 + 0.5) * dx {
+        return Err(cx.err(
+            key,
+            format!(
+                "{rows} rows need a kernel support of at least {:.3e} m to see the row under them, got {support:.3e} m",
+                (rows as f64 + 0.5) * dx
+            ),
+        ));
+    }
+    Ok(rows)
 }
 
 /// `surface_tension.contact_angle`, one angle or a table of every wall and solid
@@ -321,6 +360,7 @@ mod tests {
                 adsorption_enthalpy: -1.66e5,
             })),
             contact_angle: None,
+            thin_layer_rows: 0,
         };
         let s = law(1.3e-8);
         assert!(

@@ -115,11 +115,13 @@ pub fn body_channels(_m: &Model, st: &State) -> Vec<Field> {
 /// liquid), `thermal_gradient` G (K/m), `cooling_rate` (K/s) and
 /// `solidification_rate` R (m/s), 0 where there is no record.
 pub fn solidification_channels(m: &Model, st: &State) -> Vec<Field> {
-    let mut by_id: Vec<Option<crate::solidification::Record>> = vec![None; st.solidification.len() / 2];
+    let mut by_id: Vec<Option<crate::solidification::Record>> =
+        vec![None; st.solidification.len() / 2];
     for r in crate::solidification::records(m, st) {
         by_id[r.id as usize] = Some(r);
     }
-    let recs: Vec<Option<crate::solidification::Record>> = st.id.iter().map(|&k| by_id[k as usize]).collect();
+    let recs: Vec<Option<crate::solidification::Record>> =
+        st.id.iter().map(|&k| by_id[k as usize]).collect();
     let col = |f: fn(&crate::solidification::Record) -> f64, none: f32| {
         Values::F32(
             recs.iter()

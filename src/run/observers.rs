@@ -6,8 +6,8 @@ use super::{Outputs, RunEnd, RunOptions};
 use crate::checks::{CheckResult, Checker};
 use crate::diagnostics::{Diagnostics, Leakage, TRACK_TOPIC};
 use crate::model::Model;
-use crate::state::State;
 use crate::solidification;
+use crate::state::State;
 use crate::track::{Track, TrackProfile};
 
 /// Which state an observer is shown.
@@ -262,7 +262,8 @@ impl Observer for SolidificationRecords {
             return Ok(());
         };
         let sizes: Vec<usize> = self.samples.iter().map(|s| s.1.len()).collect();
-        let all: Vec<solidification::Record> = self.samples.iter().flat_map(|s| s.1.clone()).collect();
+        let all: Vec<solidification::Record> =
+            self.samples.iter().flat_map(|s| s.1.clone()).collect();
         let mut all = solidification::with_front_speeds(m, all).into_iter();
         for ((time, _), size) in self.samples.iter().zip(sizes) {
             let mut batch = solidification::Batch {

@@ -28,7 +28,7 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
 use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
 use crate::state::State;
-use crate::state::{H_TEMPERATURE, S_CURVATURE, S_DELTA, S_RAW_CURVATURE};
+use crate::state::{H_TEMPERATURE, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_THIN};
 use rayon::prelude::*;
 
 /// F22 (21) f[T, T_m, T_m + ΔT_s]; 1 without a ramp. max then min, as the WGSL
@@ -164,16 +164,23 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
             * s.surface[j][S_DELTA]
     };
     let kmax = pr.tension.kappa_max;
-    let kappa: Vec<f32> = (0..active)
+    let thin_depth = pr.tension.thin_layer_depth;
+    let kappa: Vec<(f32, bool)> = (0..active)
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
             if s.phase[i] != liquid || n_i[S_DELTA] == 0.0 {
-                return 0.0;
+                return (0.0, false);
             }
             let (mut num, mut den) = (0.0f32, 0.0f32);
+            let mut deep = false;
             for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
                 let n_j = s.surface[j];
+                if s.phase[j] == liquid
+                    && d[0] * n_i[0] + d[1] * n_i[1] + d[2] * n_i[2] >= thin_depth
+                {
+                    deep = true;
+                }
                 if s.phase[j] != liquid || n_j[3] == 0.0 {
                     return;
                 }
@@ -188,11 +195,14 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
                 }
             });
             let k = if den > 0.0 { -(num / den) } else { 0.0 };
-            k.max(-kmax).min(kmax)
+            (k.max(-kmax).min(kmax), thin_depth > 0.0 && !deep)
         })
         .collect();
-    for (i, k) in kappa.into_iter().enumerate() {
+    for (i, (k, thin)) in kappa.into_iter().enumerate() {
         st.surface[n + i][S_RAW_CURVATURE] = k;
+        if thin {
+            st.surface[n + i][S_THIN] = 1.0;
+        }
     }
 }
 
@@ -212,7 +222,7 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
     let temperature = |j: usize| temperature(pr, s, j);
     let has_temperature = |ph: u32| has_temperature(pr, ph);
     let volume = |j: usize| s.mass[j] / pr.phase(s.phase[j]).rho0;
-    let out: Vec<Option<([f32; 3], f32)>> = (0..active)
+    let out: Vec<Option<([f32; 3], f32, bool)>> = (0..active)
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
@@ -246,13 +256,22 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
             if shepard > 0.0 {
                 gt = [gt[0] / shepard, gt[1] / shepard, gt[2] / shepard];
             }
-            Some((force(pr, n_i, t_i, kappa, gt, rho0), kappa))
+            // R18 §4.4: none on a layer of thin_layer_rows particles or fewer.
+            let thin = s.surface[n + i][S_THIN] != 0.0;
+            let a = if thin {
+                [0.0; 3]
+            } else {
+                force(pr, n_i, t_i, kappa, gt, rho0)
+            };
+            Some((a, kappa, thin))
         })
         .collect();
     for (i, o) in out.into_iter().enumerate() {
-        let Some((a, kappa)) = o else { continue };
-        for c in 0..3 {
-            st.acc[i][c] += a[c];
+        let Some((a, kappa, thin)) = o else { continue };
+        if !thin {
+            for c in 0..3 {
+                st.acc[i][c] += a[c];
+            }
         }
         st.surface[n + i][S_CURVATURE] = kappa;
     }

@@ -13,7 +13,10 @@ last commit before the issue-14 redesign (3003071) on this project's 2-core
 machine with Mesa lavapipe; `--write` replaces them. poiseuille_2d and couette_2d
 were rewritten when the periodic cell count stopped depending on rounding (4 cells
 across their period instead of 3: the neighbour order, and so the last bits, changed;
-CPU and GPU still agree). Exit 0 when every hash
+CPU and GPU still agree); melt_block_3d and melting_grain_2d when the
+solidification record (issue 29) joined the checkpoints of melting scenes (every
+array they had before compared equal after 200 steps, frame by frame, against the
+binary of the commit before it, 68d391c). Exit 0 when every hash
 matches, 1 otherwise. Not part of CI (about a minute on 2 cores).
 """
 import argparse

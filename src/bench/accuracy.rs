@@ -553,6 +553,13 @@ pub fn accuracy(opts: &Options) -> Result<(), SpatterError> {
             orders.push(fit);
         }
     }
+    let table = formulation_table(&runs);
+    if !table.is_empty() {
+        println!("formulations side by side (each scene as written and as its @variant):");
+        for line in table {
+            println!("{line}");
+        }
+    }
     println!("backend: {backend}");
     let report = AccuracyReport {
         backend,
@@ -567,6 +574,33 @@ pub fn accuracy(opts: &Options) -> Result<(), SpatterError> {
         super::write_json(path, &report)?;
     }
     Ok(())
+}
+
+/// Issue 28 item 3: every resolution at which a scene ran both as written and as
+/// an `@variant` (another formulation), the two errors and wall times on one
+/// line, so a user sees which formulation buys its error for less time.
+fn formulation_table(runs: &[AccuracyRun]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for v in runs.iter().filter(|r| r.scene.contains('@')) {
+        let (base, variant) = v.scene.split_once('@').unwrap_or((&v.scene, ""));
+        let Some(b) = runs
+            .iter()
+            .find(|b| b.scene == base && b.kernel == v.kernel && b.cells == v.cells)
+        else {
+            continue;
+        };
+        let cheaper = match (b.error <= v.error, b.wall_s <= v.wall_s) {
+            (true, true) => "as written: smaller error in less time".to_string(),
+            (false, false) => format!("{variant}: smaller error in less time"),
+            (true, false) => "as written: smaller error, more time".to_string(),
+            (false, true) => format!("{variant}: smaller error, more time"),
+        };
+        lines.push(format!(
+            "  {base:<24} {:<11} n {:>3}: as written error {:.3e} in {:.2} s; {variant} error {:.3e} in {:.2} s ({cheaper})",
+            v.kernel, v.cells, b.error, b.wall_s, v.error, v.wall_s
+        ));
+    }
+    lines
 }
 
 fn write_plots(dir: &Path, rep: &AccuracyReport) -> Result<(), SpatterError> {
@@ -651,5 +685,58 @@ fn convergence_series(rep: &AccuracyReport, scene: &str) -> Series {
     Series {
         label: scene.to_string(),
         points,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(scene: &str, cells: u32, error: f64, wall_s: f64) -> AccuracyRun {
+        AccuracyRun {
+            scene: scene.into(),
+            kernel: "quintic".into(),
+            cells,
+            dx: 1.0 / cells as f64,
+            particles: 0,
+            steps: 0,
+            wall_s,
+            particle_steps_per_s: 0.0,
+            state_bytes: 0.0,
+            peak_rss_bytes: None,
+            metric: String::new(),
+            error,
+            tolerance: 1.0,
+            pass: true,
+            end: "completed".into(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// One line per resolution both formulations ran, pairing each variant with
+    /// the scene as written at the same n and kernel.
+    #[test]
+    fn formulations_pair_by_resolution() {
+        let runs = [
+            run("disc", 10, 0.2, 1.0),
+            run("disc", 20, 0.03, 4.0),
+            run("disc@wcsph", 10, 2.1, 0.8),
+            run("disc@wcsph", 20, 2.9, 3.0),
+            run("disc@wcsph", 40, 7.6, 12.0),
+            run("other", 10, 0.1, 1.0),
+        ];
+        let t = formulation_table(&runs);
+        assert_eq!(t.len(), 2, "{t:?}");
+        assert!(
+            t[0].contains("n  10") && t[0].contains("as written error 2.000e-1"),
+            "{}",
+            t[0]
+        );
+        assert!(
+            t[1].contains("wcsph error 2.900e0")
+                && t[1].contains("as written: smaller error, more time"),
+            "{}",
+            t[1]
+        );
     }
 }

@@ -82,7 +82,7 @@ pub fn records(m: &Model, st: &State) -> Vec<Record> {
 /// the kernel's support (weights (1 − r/support)², renormalised as on the device)
 /// that crossed within the time the front takes to cross four supports at the
 /// record's local R (local cooling rate / G): a later track's remelt does not mix
-/// in. Why not R = (−dT/dT)/G alone: the latent heat leaves the front as a jump in
+/// in. Why not R = (−dT/dt)/G alone: the latent heat leaves the front as a jump in
 /// the gradient, which the SPH Laplacian smooths over the kernel, so a liquid
 /// particle cools faster than the analytic liquid as the front reaches it
 /// (+19% on solidification_1d, not falling with Δx); the crossing times carry no

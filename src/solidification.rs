@@ -20,6 +20,7 @@
 
 use crate::model::Model;
 use crate::state::{State, SOL_COOLING, SOL_COUNT, SOL_GRADIENT, SOL_TIME};
+use glam::{DMat3, DVec3};
 use serde::Serialize;
 
 pub const SOLIDIFICATION_TOPIC: &str = "/solidification";
@@ -114,7 +115,7 @@ pub fn with_front_speeds(m: &Model, mut recs: Vec<Record>) -> Vec<Record> {
                 f64::INFINITY
             };
             let c = cell_of(&r.position);
-            let (mut mm, mut b) = ([0.0f64; 6], [0.0f64; 3]);
+            let (mut mm, mut b) = (DMat3::ZERO, DVec3::ZERO);
             let mut count = 0;
             for o in &offsets {
                 let Some(list) = cells.get(&[c[0] + o[0], c[1] + o[1], c[2] + o[2]]) else {
@@ -122,20 +123,14 @@ pub fn with_front_speeds(m: &Model, mut recs: Vec<Record>) -> Vec<Record> {
                 };
                 for &j in list.iter().filter(|&&j| j != k) {
                     let q = &recs[j];
-                    let d: [f64; 3] = std::array::from_fn(|a| q.position[a] - r.position[a]);
-                    let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let d = DVec3::from(q.position) - DVec3::from(r.position);
+                    let dist = d.length();
                     if dist >= support || dist == 0.0 || (q.time - r.time).abs() > window {
                         continue;
                     }
                     let w = (1.0 - dist / support).powi(2);
-                    let dt = q.time - r.time;
-                    let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-                    for (e, (a, bb)) in pairs.iter().enumerate() {
-                        mm[e] += w * d[*a] * d[*bb];
-                    }
-                    for a in 0..3 {
-                        b[a] += w * dt * d[a];
-                    }
+                    mm += DMat3::from_cols(d * d.x, d * d.y, d * d.z) * w;
+                    b += d * (w * (q.time - r.time));
                     count += 1;
                 }
             }
@@ -152,36 +147,19 @@ pub fn with_front_speeds(m: &Model, mut recs: Vec<Record>) -> Vec<Record> {
     recs
 }
 
-/// |g| of M g = b for the symmetric M = (xx, xy, xz, yy, yz, zz) (the 2×2
-/// block in 2D), in f64; None where M is near singular relative to its size
-/// (the neighbours lie on a line).
-fn fit_gradient(dim: u32, m: [f64; 6], b: [f64; 3]) -> Option<f64> {
-    let [xx, xy, xz, yy, yz, zz] = m;
-    let scale = xx + yy + zz;
-    if dim == 2 {
-        let det = xx * yy - xy * xy;
-        if det <= 1e-6 * scale * scale {
-            return None;
-        }
-        let g = [(yy * b[0] - xy * b[1]) / det, (xx * b[1] - xy * b[0]) / det];
-        return Some((g[0] * g[0] + g[1] * g[1]).sqrt());
-    }
-    let c00 = yy * zz - yz * yz;
-    let c01 = xz * yz - xy * zz;
-    let c02 = xy * yz - xz * yy;
-    let c11 = xx * zz - xz * xz;
-    let c12 = xy * xz - xx * yz;
-    let c22 = xx * yy - xy * xy;
-    let det = xx * c00 + xy * c01 + xz * c02;
-    if det <= 1e-9 * scale * scale * scale {
-        return None;
-    }
-    let g = [
-        (c00 * b[0] + c01 * b[1] + c02 * b[2]) / det,
-        (c01 * b[0] + c11 * b[1] + c12 * b[2]) / det,
-        (c02 * b[0] + c12 * b[1] + c22 * b[2]) / det,
-    ];
-    Some((g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt())
+/// |g| of M g = b (the weighted moments of the neighbours' offsets), in f64;
+/// None where M is near singular relative to its size (the neighbours lie on a
+/// line). In 2D the z row and column are empty: M_zz takes the mean of the
+/// diagonal so that the 3×3 inverse solves the 2×2 block.
+fn fit_gradient(dim: u32, mut m: DMat3, b: DVec3) -> Option<f64> {
+    let trace = m.x_axis.x + m.y_axis.y + m.z_axis.z;
+    let limit = if dim == 2 {
+        m.z_axis.z = 0.5 * trace;
+        1e-6 * trace * trace * m.z_axis.z
+    } else {
+        1e-9 * trace * trace * trace
+    };
+    (m.determinant() > limit).then(|| (m.inverse() * b).length())
 }
 
 /// One `/solidification` message: the records new since the previous sample,

@@ -334,6 +334,14 @@ pub enum LaserModel {
     GaussianSurface,
 }
 
+/// `laser.power`: one number, or a [time, power] schedule.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum PowerDef {
+    Constant(f64),
+    Schedule(Vec<Vec<f64>>),
+}
+
 /// A laser heat source. The beam points down the last axis (−y in 2D, −z in 3D).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -345,9 +353,14 @@ pub struct LaserDef {
     pub radius: f64,
     /// Beer–Lambert absorption coefficient (1/m).
     pub absorption_coefficient: Option<f64>,
-    /// Power schedule: [time, power] pairs, each power held from its time on
-    /// (W; W per metre of depth in 2D). Before the first time the beam is off.
-    pub power: Vec<Vec<f64>>,
+    /// Beam power (W; W per metre of depth in 2D): one number, held from t = 0,
+    /// or a schedule of [time, power] pairs, each power held from its time on
+    /// (before the first time the beam is off). One number is what `spatter
+    /// sweep --vary laser.power=...` varies.
+    pub power: PowerDef,
+    /// s: the beam goes off for good at this time, whatever `power` says (a
+    /// line melt's end, kept apart from the power so a sweep can vary it).
+    pub power_until: Option<f64>,
     /// Scan path: [time, x] (2D) or [time, x, y] (3D) beam centres, linear in
     /// between and held before the first and after the last.
     pub path: Vec<Vec<f64>>,
@@ -793,6 +806,9 @@ pub struct CheckDef {
     /// at failure (default 0.41: R18 Test 2 split at a 140% density increase,
     /// 1.41 / 0.59 = 2.4).
     pub swing: Option<f64>,
+    /// R18 track: the depth (m) a 2D slice stands for, so that R18's watts are
+    /// the power per metre times it. Its `surface` is the plate's initial top.
+    pub r18_slice_depth: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -874,6 +890,9 @@ pub enum CheckKind {
     /// R18 Test 4: the RMS departure of interior pressures from their local
     /// smooth mean, relative to ρ_l g H (checks/noise.rs).
     PressureNoise,
+    /// R18 §5.1.1: a 2D powder-bed track's substrate penetration, peak
+    /// temperature and speed beside R18's Table 5.3 at the run's power.
+    R18Track,
 }
 
 impl CheckKind {
@@ -908,6 +927,7 @@ impl CheckKind {
             CheckKind::RisingAmplitude => "rising_amplitude",
             CheckKind::ColumnExpansion => "column_expansion",
             CheckKind::PressureNoise => "pressure_noise",
+            CheckKind::R18Track => "r18_track",
         }
     }
 }

@@ -277,7 +277,9 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
         "laser_peak_power": m.laser.as_ref().map(|l| l.power.iter().map(|p| p.1).fold(0.0, f64::max)),
         "track": track,
         "check": r.check.as_ref().map(|c| serde_json::json!({
-            "name": c.name, "value": c.value, "tolerance": c.tolerance, "pass": c.pass
+            "name": c.name, "value": c.value, "tolerance": c.tolerance, "pass": c.pass,
+            "figures": c.figures.iter().map(|(k, v)| (k.clone(), serde_json::json!(v)))
+                .collect::<serde_json::Map<String, serde_json::Value>>(),
         })),
     })
 }

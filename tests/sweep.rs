@@ -20,7 +20,7 @@ fn sweep(dir: &std::path::Path, extra: &[&str]) -> (Option<i32>, String) {
         "sweep",
         &scene,
         "--vary",
-        "laser.absorptivity=0.3,0.6",
+        "laser.power=1.0e6,2.0e6",
         "--set",
         "run.end_time=3e-5",
         "--backend",
@@ -44,10 +44,10 @@ fn a_local_sweep_runs_each_cell_once_and_collects_a_map() {
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 3, "{csv}");
     assert!(
-        rows[0].starts_with("laser.absorptivity,exit_code,max_depth_m"),
+        rows[0].starts_with("laser.power,exit_code,max_depth_m"),
         "{csv}"
     );
-    // More absorbed power melts deeper; both conduction mode at 30 µs.
+    // More power melts deeper; both conduction mode at 30 µs.
     let depth = |r: &str| r.split(',').nth(2).unwrap().parse::<f64>().unwrap();
     assert!(depth(rows[2]) > depth(rows[1]), "{csv}");
     assert!(
@@ -116,4 +116,11 @@ fn a_bad_value_in_the_grid_is_an_input_error_before_any_run() {
     );
     assert!(!dir.join("manifest.json").exists());
     common::assert_input_error(&["sweep", &scene, "--vary", "laser.absorptivity"], "--vary");
+    // the README's line melt gives its power as one number, so a map can vary it
+    let out = common::spatter(&["validate", &scene, "--set", "laser.power=2.0e6"]);
+    assert_eq!(out.status.code(), Some(0), "{}", common::text(&out).1);
+    common::assert_input_error(
+        &["validate", &scene, "--set", "laser.power_until=0.0"],
+        "laser.power_until",
+    );
 }

@@ -98,6 +98,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     ),
     (scene_file!("pbf/line_melt_bare_plate"), &["dx=2e-5"]),
     (scene_file!("pbf/line_melt_coarse_2d"), &[]),
+    (scene_file!("pbf/r18_track_2d"), &[]),
     (
         scene_file!("pbf/powder_bed_line_melt_coarse_2d"),
         &["dx=1e-5"],
@@ -277,10 +278,7 @@ fn extremes(quick: bool) -> Result<Vec<Case>, SpatterError> {
         &[50.0, 100.0, 200.0, 400.0]
     };
     for &w in powers {
-        let sets = with(
-            coarse("2e-5"),
-            format!("laser.power=[[0.0, {w}], [3.7e-4, 0.0]]"),
-        );
+        let sets = with(coarse("2e-5"), format!("laser.power={w}"));
         cases.push(extreme(melt, "laser power (W)", w, sets, steps));
     }
     // Fixed Δt as a fraction of the F22 (42) limit at that resolution.

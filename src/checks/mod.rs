@@ -9,7 +9,7 @@
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
 //! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
 //! expansion.rs (δ-SPH thermal expansion: R18 Tests 1, 2 and 3), noise.rs (pressure
-//! noise: R18 Test 4).
+//! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track).
 
 mod bodies;
 mod compression;
@@ -21,6 +21,7 @@ mod noise;
 mod solidification;
 mod tension;
 pub mod thermocapillary;
+mod track;
 mod two_layer;
 
 pub use dam_break::{fit_release_delay, ReleaseDelayFit};
@@ -165,6 +166,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
             Box::new(expansion::ColumnExpansion::new(c.area.unwrap_or(f64::NAN)))
         }
         CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
+        CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -102,9 +102,20 @@ pub(super) fn expansion_table(
     scene: &SceneFile,
     phases: &mut [PhaseInfo],
 ) -> Result<(), InputError> {
+    // A solid or wall phase keeps its place, so a law cannot expand it; it may
+    // share the law's material with a fluid phase (the liquid a solid melts
+    // into must share its material), and then the fluid alone takes the law.
+    let fluid_materials: Vec<&String> = phases
+        .iter()
+        .filter(|ph| ph.is_fluid())
+        .map(|ph| &scene.phases[&ph.name].material)
+        .collect();
     for ph in phases.iter_mut() {
         let def = &scene.phases[&ph.name];
         if let Some(points) = &scene.materials[&def.material].density_law {
+            if !ph.is_fluid() && fluid_materials.contains(&&def.material) {
+                continue;
+            }
             let key = format!("materials.{}.density_law", def.material);
             ph.density_law = Some(density_law(cx, scene, ph, &key, points)?);
         }
@@ -139,7 +150,7 @@ fn density_law(
             key,
             format!(
                 "phase `{}` is a wall or solid: its particles stay in place, so a density \
-                 law cannot expand them (give it to the liquid it melts into)",
+                 law cannot expand them (give it to a fluid phase's material)",
                 ph.name
             ),
         ));

@@ -115,12 +115,23 @@ pub(super) fn laser_source(
             }
             Ok(list.clone())
         };
-    let power = points("laser.power", &l.power, 2)?
+    let schedule = match &l.power {
+        crate::scene::PowerDef::Constant(p) => vec![vec![0.0, *p]],
+        crate::scene::PowerDef::Schedule(list) => list.clone(),
+    };
+    let mut power = points("laser.power", &schedule, 2)?
         .iter()
         .map(|e| (e[0], e[1]))
         .collect::<Vec<_>>();
     if let Some(k) = power.iter().position(|p| p.1 < 0.0) {
-        return Err(cx.err(&format!("laser.power[{k}]"), "power must be >= 0"));
+        let key = match l.power {
+            crate::scene::PowerDef::Constant(_) => "laser.power".to_string(),
+            crate::scene::PowerDef::Schedule(_) => format!("laser.power[{k}]"),
+        };
+        return Err(cx.err(&key, "power must be >= 0"));
+    }
+    if let Some(t_off) = l.power_until {
+        power = switch_off(power, t_off).map_err(|why| cx.err("laser.power_until", why))?;
     }
     let path = points("laser.path", &l.path, dim as usize)?
         .iter()
@@ -134,4 +145,40 @@ pub(super) fn laser_source(
         power,
         path,
     }))
+}
+
+/// The schedule with the beam off from t_off on: steps at or after t_off are
+/// dropped and a [t_off, 0] step ends it.
+fn switch_off(mut power: Vec<(f64, f64)>, t_off: f64) -> Result<Vec<(f64, f64)>, String> {
+    if !t_off.is_finite() || t_off <= power[0].0 {
+        return Err(format!(
+            "must be a time after the first power step ({} s), got {t_off}",
+            power[0].0
+        ));
+    }
+    power.retain(|p| p.0 < t_off);
+    if power.len() >= MAX_LASER_POINTS {
+        return Err(format!(
+            "the schedule and its switch-off hold more than {MAX_LASER_POINTS} steps"
+        ));
+    }
+    power.push((t_off, 0.0));
+    Ok(power)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::switch_off;
+
+    #[test]
+    fn power_until_ends_any_schedule_with_the_beam_off() {
+        let one = switch_off(vec![(0.0, 150.0)], 3.7e-4).unwrap();
+        assert_eq!(one, vec![(0.0, 150.0), (3.7e-4, 0.0)]);
+        // steps at or after the switch-off go; the schedule before it stays
+        let table = vec![(0.0, 100.0), (1.0e-4, 200.0), (4.0e-4, 50.0)];
+        let cut = switch_off(table, 3.0e-4).unwrap();
+        assert_eq!(cut, vec![(0.0, 100.0), (1.0e-4, 200.0), (3.0e-4, 0.0)]);
+        assert!(switch_off(vec![(1.0e-4, 1.0)], 1.0e-4).is_err());
+        assert!(switch_off(vec![(0.0, 1.0)], f64::NAN).is_err());
+    }
 }

@@ -432,8 +432,11 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .iter()
         .filter(|p| p.conducts())
         .map(|p| {
+            // the stiffer of the solid and liquid states: a melt whose
+            // conductivity is scaled (R18 §4.4's x10) diffuses faster
             let t = p.thermal.unwrap();
-            0.1 * p.rho0 * t.heat_capacity * h * h / t.conductivity
+            let limit = |c: f64, k: f64| 0.1 * p.rho0 * c * h * h / k;
+            limit(t.heat_capacity, t.conductivity).min(limit(t.liquid.1, t.liquid.0))
         })
         .fold(f64::INFINITY, f64::min);
     let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
@@ -578,6 +581,28 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         warnings.push(w);
     }
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
+    if let Some(c) = scene
+        .check
+        .as_ref()
+        .filter(|c| c.kind == crate::scene::CheckKind::R18Track)
+    {
+        cx.positive(
+            "check.r18_slice_depth",
+            c.r18_slice_depth.unwrap_or(f64::NAN),
+        )?;
+        if !c.surface.is_some_and(f64::is_finite) {
+            return Err(cx.err(
+                "check.surface",
+                "\"r18_track\" needs the plate's initial top (m)",
+            ));
+        }
+        if laser.is_none() || dim != 2 {
+            return Err(cx.err(
+                "check.kind",
+                "\"r18_track\" needs a 2D scene with a [laser]",
+            ));
+        }
+    }
     let stop_when_solidified = stop_when(&cx, run, laser.as_ref(), &phases)?;
     let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
     let delta = delta_coefficient(&cx, sim)?;

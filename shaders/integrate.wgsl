@@ -34,29 +34,6 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     pos[i] = stamp_if_left(x);
 }
 
-// A fluid particle that has just left the keep box carries the time it left in
-// w; the neighbour pass then sorts it last and the passes stop before it (issue
-// 18). Walls are never removed.
-fn stamp_if_left(x: vec4<f32>) -> vec4<f32> {
-    var y = x;
-    if (outside_keep_box(x)) {
-        y.w = sim.time + sim.dt;
-    }
-    return y;
-}
-
-// Brings coordinate x of axis c back into [0, period) on a periodic axis.
-fn wrap_periodic(x: f32, c: u32) -> f32 {
-    if ((P.sizes.flags & (1u << c)) != 0u) {
-        if (x >= P.grid.period[c]) {
-            return x - P.grid.period[c];
-        } else if (x < 0.0) {
-            return x + P.grid.period[c];
-        }
-    }
-    return x;
-}
-
 @compute @workgroup_size(64)
 fn kick(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);

@@ -64,6 +64,9 @@ pub struct Header {
     /// A phase melts: the solidification record (2n × 4 f32, by id) follows.
     #[serde(default)]
     pub solidification: bool,
+    /// DFSPH: the dfsph array follows.
+    #[serde(default)]
+    pub dfsph: bool,
     /// Entries of each table (crate::fields::TABLES), stored after the particle
     /// arrays in registry order; a table not named here is empty.
     #[serde(default)]
@@ -97,6 +100,7 @@ pub fn encode(m: &Model, st: &State, backend: &str) -> Vec<u8> {
         heat_start: !st.heat_start.is_empty(),
         continuity: !st.continuity.is_empty(),
         solidification: !st.solidification.is_empty(),
+        dfsph: !st.dfsph.is_empty(),
         tables: TABLES
             .iter()
             .map(|t| (t.name.to_string(), t.entries(st) as u64))
@@ -179,6 +183,7 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
         solvers: false, // a table, not a particle array
         continuity: header.continuity,
         solidification: header.solidification,
+        dfsph: header.dfsph,
     };
     let mut state = State::default();
     for f in FIELDS.iter().filter(|f| f.checkpointed) {

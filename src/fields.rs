@@ -31,6 +31,8 @@ pub enum Holder {
     Solvers,
     /// The δ-SPH formulation (continuity density: ρ is state, sorted).
     Continuity,
+    /// The DFSPH formulation (the solvers' per-particle values).
+    Dfsph,
     /// Scenes with a phase that melts (the solidification record).
     Solidification,
 }
@@ -45,6 +47,7 @@ pub struct Held {
     pub solvers: bool,
     pub continuity: bool,
     pub solidification: bool,
+    pub dfsph: bool,
 }
 
 impl Held {
@@ -57,6 +60,7 @@ impl Held {
             Holder::ImplicitHeat => self.implicit_heat,
             Holder::Solvers => self.solvers,
             Holder::Continuity => self.continuity,
+            Holder::Dfsph => self.dfsph,
             Holder::Solidification => self.solidification,
         }
     }
@@ -70,6 +74,7 @@ impl Held {
             solvers: !st.solvers.is_empty(),
             continuity: !st.continuity.is_empty(),
             solidification: !st.solidification.is_empty(),
+            dfsph: !st.dfsph.is_empty(),
         }
     }
     /// What a scene holds, from its model (the same as its schedule's features:
@@ -77,15 +82,16 @@ impl Held {
     pub fn of_model(m: &crate::model::Model) -> Held {
         let implicit_heat =
             m.is_thermal() && m.heat.integrator == crate::scene::HeatIntegrator::Trapezoidal;
+        let dfsph = m.formulation == crate::scene::Formulation::Dfsph;
         Held {
             heat: m.is_thermal(),
             interface: m.needs_interface(),
             bodies: m.has_bodies(),
             implicit_heat,
-            // The trapezoidal heat is the only repeat so far.
-            solvers: implicit_heat,
+            solvers: implicit_heat || dfsph,
             continuity: m.formulation == crate::scene::Formulation::DeltaWcsph,
             solidification: m.melts(),
+            dfsph,
         }
     }
 }
@@ -176,7 +182,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 17] = [
+pub const FIELDS: [FieldDef; 19] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -213,6 +219,12 @@ pub const FIELDS: [FieldDef; 17] = [
     // correction, written by the continuity pass every step after the sort.
     field!("density_gradient", density_gradient, "density_gradient", None, 4, 1, true,
         Holder::Continuity, None),
+    // DFSPH: written by the factor pass every step after the sort.
+    field!("dfsph", dfsph, "dfsph", None, 4, 1, true, Holder::Dfsph, None),
+    // DFSPH: the warm starts (Δt² Σκ of the density solve, Δt Σκ of the
+    // divergence solve), carried to the next step (sorted).
+    field!("dfsph_warm", dfsph_warm, "dfsph_warm", Some("s_dfsph_warm"), 2, 1, true,
+        Holder::Dfsph, None),
     // Written by heat.begin every step after the sort (no scratch needed).
     field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
         None),
@@ -292,6 +304,7 @@ pub fn wgsl_reorder(k: &str, s: &str, indent: &str) -> String {
         Holder::Bodies => Some("FLAG_BODIES"),
         Holder::Interface => Some("FLAG_INTERFACE"),
         Holder::Continuity => Some("FLAG_CONTINUITY"),
+        Holder::Dfsph => Some("FLAG_DFSPH"),
         Holder::Every => None,
         other => panic!("no scene flag for sorted fields of {other:?}"),
     };

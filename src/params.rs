@@ -52,6 +52,8 @@ pub const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768;
 /// particle's liquidus crossing on cooling and the `solidification_gradient`
 /// dispatch its |∇T| (`State::solidification`, issue 29).
 pub const FLAG_SOLIDIFICATION: u32 = 65536;
+/// Divergence-free SPH: its warm-start store is sorted with the particles.
+pub const FLAG_DFSPH: u32 = 131072;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -383,6 +385,12 @@ gpu_struct! {
         pub delta_hc: f32,
         /// δ-SPH: 2 (d + 2) of the Monaghan–Marrone viscosity R18 (3.18).
         pub viscosity_factor: f32,
+        /// DFSPH: the density solve stops at this mean (ρ* − ρ0)/ρ0.
+        pub dfsph_density_tolerance: f32,
+        /// DFSPH: the divergence solve stops at this mean Δt Dρ/Dt / ρ0.
+        pub dfsph_divergence_tolerance: f32,
+        /// DFSPH: each solve's bound.
+        pub dfsph_max_iterations: u32,
     }
 }
 
@@ -603,9 +611,15 @@ impl Params {
                 .delta
                 .map_or(0.0, |d| (d * m.h * m.max_sound_speed()) as f32),
             viscosity_factor: (2.0 * (m.dim as f64 + 2.0)) as f32,
+            dfsph_density_tolerance: m.dfsph.density_tolerance as f32,
+            dfsph_divergence_tolerance: m.dfsph.divergence_tolerance as f32,
+            dfsph_max_iterations: m.dfsph.max_iterations,
         };
         if m.delta.is_some() {
             p.sizes.flags |= FLAG_CONTINUITY;
+        }
+        if m.formulation == crate::scene::Formulation::Dfsph {
+            p.sizes.flags |= FLAG_DFSPH;
         }
         if m.viscosity_form == crate::scene::ViscosityForm::Marrone {
             p.sizes.flags |= FLAG_MARRONE_VISCOSITY;
@@ -1116,4 +1130,46 @@ mod tests {
             assert!((got - kappa).abs() < 1e-4, "{k}: {got}");
         }
     }
+}
+
+/// W(r) in f64 (host-side setup), the kernels of `kernel_sigma`.
+pub fn kernel_w_f64(kind: KernelKind, dim: u32, h: f64, r: f64) -> f64 {
+    let q = r / h;
+    let sigma = kernel_sigma(kind, dim, h);
+    match kind {
+        KernelKind::Quintic => {
+            let p = |a: f64| (a - q).max(0.0).powi(5);
+            sigma * (p(3.0) - 6.0 * p(2.0) + 15.0 * p(1.0))
+        }
+        KernelKind::WendlandC2 => sigma * (1.0 - 0.5 * q).max(0.0).powi(4) * (2.0 * q + 1.0),
+        KernelKind::Cubic => {
+            if q < 1.0 {
+                sigma * (1.0 - 1.5 * q * q + 0.75 * q * q * q)
+            } else if q < 2.0 {
+                sigma * 0.25 * (2.0 - q).powi(3)
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+/// Σ_k W(|k| Δx) Δx^d over the square (cubic) lattice: the summation density
+/// of a particle inside a lattice of mass ρ0 Δx^d, over ρ0 (1.0026 for the
+/// quintic at h = Δx in 2D).
+pub fn lattice_density_ratio(kind: KernelKind, dim: u32, h: f64, dx: f64, support: f64) -> f64 {
+    let reach = (support / dx).ceil() as i64;
+    let z = if dim == 3 { reach } else { 0 };
+    let mut sum = 0.0;
+    for a in -reach..=reach {
+        for b in -reach..=reach {
+            for c in -z..=z {
+                let r = dx * ((a * a + b * b + c * c) as f64).sqrt();
+                if r < support {
+                    sum += kernel_w_f64(kind, dim, h, r);
+                }
+            }
+        }
+    }
+    sum * dx.powi(dim as i32)
 }

@@ -60,6 +60,8 @@ pub enum Formulation {
     Wcsph,
     /// R18's δ-SPH: continuity density with density diffusion on ρ − ρ0.
     DeltaWcsph,
+    /// Divergence-free SPH (Bender & Koschier; J22): implicit pressure.
+    Dfsph,
 }
 
 impl Formulation {
@@ -68,12 +70,14 @@ impl Formulation {
         match self {
             Formulation::Wcsph => 0,
             Formulation::DeltaWcsph => 1,
+            Formulation::Dfsph => 2,
         }
     }
     pub fn from_code(code: u32) -> Formulation {
         match code {
             0 => Formulation::Wcsph,
             1 => Formulation::DeltaWcsph,
+            2 => Formulation::Dfsph,
             c => panic!("no formulation with code {c}"),
         }
     }
@@ -81,6 +85,7 @@ impl Formulation {
         match self {
             Formulation::Wcsph => "wcsph",
             Formulation::DeltaWcsph => "delta_wcsph",
+            Formulation::Dfsph => "dfsph",
         }
     }
 }
@@ -424,6 +429,33 @@ pub struct Simulation {
     /// F22 (34) barrier force between fluid and wall particles closer than its
     /// radius: keeps splashes out of the walls. Absent: off.
     pub barrier: Option<BarrierDef>,
+    /// `formulation = "dfsph"`: the pressure solves' tolerances and bound.
+    pub dfsph: Option<DfsphDef>,
+}
+
+/// `simulation.dfsph`: when the two solves of divergence-free SPH stop.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DfsphDef {
+    /// Mean density error (ρ* − ρ0)/ρ0 over the fluid at which the
+    /// constant-density solve stops (default 1e-3: 0.1%).
+    pub density_tolerance: f64,
+    /// Mean divergence error Δt max(Dρ/Dt, 0)/ρ0 at which the divergence-free
+    /// solve stops (default 1e-3).
+    pub divergence_tolerance: f64,
+    /// Iterations each solve may take per step (default 100, at most 200: the
+    /// GPU records them all).
+    pub max_iterations: u32,
+}
+
+impl Default for DfsphDef {
+    fn default() -> Self {
+        DfsphDef {
+            density_tolerance: 1.0e-3,
+            divergence_tolerance: 1.0e-3,
+            max_iterations: 100,
+        }
+    }
 }
 
 /// `simulation.barrier`: F22 (34) F = Σ_j (k_b g + d_b g ġ) e_ij over wall

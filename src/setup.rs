@@ -352,6 +352,19 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     if held.implicit_heat {
         st.heat_start = vec![[0.0; 4]; st.len()];
     }
+    if held.dfsph {
+        st.dfsph = vec![[0.0; 4]; st.len()];
+        st.dfsph_warm = vec![[0.0; 2]; st.len()];
+        // DFSPH corrects any density above ρ0, so a lattice whose summation
+        // density is ρ0 (1 + ε) would be pushed apart at the first step (0.26%
+        // for the quintic at h = Δx in 2D: the top of a 0.4 m column left at
+        // 0.8 m/s). Every particle's mass is ρ0 Δx^d over the lattice's kernel
+        // sum (a wall particle's volume is m/ρ0: backend/cpu/dfsph.rs).
+        let ratio = crate::params::lattice_density_ratio(m.kernel, m.dim, m.h, m.dx, m.support);
+        for mass in st.mass.iter_mut() {
+            *mass = (*mass as f64 / ratio) as f32;
+        }
+    }
     if held.continuity {
         st.continuity = vec![[0.0, 1.0]; st.len()];
         st.density_gradient = vec![[0.0; 4]; st.len()];

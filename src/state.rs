@@ -73,6 +73,11 @@ pub struct State {
     pub continuity: Vec<[f32; 2]>,
     /// δ-SPH only: the renormalised gradient ⟨∇ρ̄⟩^L (xyz) of the excess density.
     pub density_gradient: Vec<[f32; 4]>,
+    /// DFSPH only (empty otherwise): fluid (α, the solve's error, κ, Σκ of the
+    /// density solve); wall (the Akinci volume V_b, 0, 0, 0).
+    pub dfsph: Vec<[f32; 4]>,
+    /// DFSPH only: the warm-start store (Δt² Σκ density, Δt Σκ divergence).
+    pub dfsph_warm: Vec<[f32; 2]>,
     /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser
     /// source of the step, the first iteration's rate ḣ_0 and the last
     /// iteration's |ḣ_k − ḣ_{k−1}|.

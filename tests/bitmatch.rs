@@ -839,3 +839,25 @@ fn powder_bed_of_1000_rigid_grains_200_steps() {
     assert_eq!(l.state.bodies.len(), 1000);
     assert_bit_identical("powder_bed_at_rest_2d", &sets, 200);
 }
+
+const DFSPH: &str = "simulation.formulation=\"dfsph\"";
+
+/// Issue 30: DFSPH's factor, both solves (repeats: every iteration's
+/// dispatches, the tree-summed residuals, the converged flags), the walls'
+/// head, predict and drift: a 2D dam break (free surface, walls) and a 3D
+/// one, with a bound of 20 iterations so the recorded passes stay few.
+#[test]
+fn dfsph_dam_break_2d_and_3d_200_steps() {
+    let sets = [
+        DFSPH,
+        "simulation.pressure_floor=false",
+        "simulation.initial_pressure=\"zero\"",
+        "simulation.dfsph={ max_iterations = 20 }",
+    ];
+    let mut with_dx = sets.to_vec();
+    with_dx.push("dx=0.005");
+    assert_bit_identical("dam_break_2d", &with_dx, 200);
+    let mut coarse = sets.to_vec();
+    coarse.push("dx=0.04");
+    assert_bit_identical("dam_break_3d", &coarse, 200);
+}

@@ -22,6 +22,29 @@ fn outside_keep_box(p: vec4<f32>) -> bool {
     return p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y || p.z < lo.z || p.z > hi.z;
 }
 
+// A fluid particle that has just left the keep box carries the time it left in
+// w; the neighbour pass then sorts it last and the passes stop before it (issue
+// 18). Walls are never removed.
+fn stamp_if_left(x: vec4<f32>) -> vec4<f32> {
+    var y = x;
+    if (outside_keep_box(x)) {
+        y.w = sim.time + sim.dt;
+    }
+    return y;
+}
+
+// Brings coordinate x of axis c back into [0, period) on a periodic axis.
+fn wrap_periodic(x: f32, c: u32) -> f32 {
+    if ((P.sizes.flags & (1u << c)) != 0u) {
+        if (x >= P.grid.period[c]) {
+            return x - P.grid.period[c];
+        } else if (x < 0.0) {
+            return x + P.grid.period[c];
+        }
+    }
+    return x;
+}
+
 fn cell_coord(p: vec4<f32>) -> vec3<i32> {
     var c: vec3<i32>;
     for (var a = 0u; a < 3u; a++) {

@@ -116,6 +116,9 @@ struct Solve {                // the formulation and its solvers (backend::sched
     heat_max_iterations: u32,
     delta_hc: f32,            // delta h c0, R18 (3.53)
     viscosity_factor: f32,    // 2 (d + 2), R18 (3.18)
+    dfsph_density_tolerance: f32,     // DFSPH: mean (rho* - rho0)/rho0
+    dfsph_divergence_tolerance: f32,  // DFSPH: mean dt max(D rho/Dt, 0)/rho0
+    dfsph_max_iterations: u32,
 }
 
 struct Phase {
@@ -272,6 +275,7 @@ const FLAG_CONTINUITY: u32 = 8192u;
 const FLAG_MARRONE_VISCOSITY: u32 = 16384u;
 const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768u;
 const FLAG_SOLIDIFICATION: u32 = 65536u;
+const FLAG_DFSPH: u32 = 131072u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;
@@ -294,6 +298,8 @@ const LASER_SURFACE: u32 = 2u;
 const HEAT_EULER: u32 = 0u;
 const HEAT_TRAPEZOIDAL: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;
+const SOLVER_DENSITY: u32 = 1u;
+const SOLVER_DIVERGENCE: u32 = 2u;
 // Slots of the packed per-particle vectors (src/state.rs, same names): heat[i]
 // is (h, T, f_l, dh/dt); surface[i] is (normal xyz, delta) and surface[n + i]
 // (Shepard sum, curvature, raw curvature, -).

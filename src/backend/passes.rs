@@ -4,6 +4,7 @@
 //! whatever the schedule lists, dispatch by dispatch from these rows.
 
 use super::cpu::CpuBackend;
+use super::schedule::SolverSlot;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT,
     FLAG_INTERFACE, FLAG_RECOIL, FLAG_SOLIDIFICATION, FLAG_SURFACE_TENSION, FLAG_WETTING,
@@ -62,6 +63,26 @@ pub enum Stage {
     /// The iteration's residual max|ḣ_k − ḣ_{k−1}| / max|ḣ_0 + ḣ_k| and the
     /// solver's converged flag.
     HeatResidual,
+    /// DFSPH: the walls' Akinci volumes, then each fluid particle's density and
+    /// factor α (pressure 0 for the non-pressure forces).
+    DfsphFactor,
+    /// DFSPH divergence-free solve: reset, first errors Dρ/Dt.
+    DfsphDivergenceBegin,
+    /// One iteration: κ, the velocity correction, the new errors.
+    DfsphDivergenceIterate,
+    /// The mean divergence error and the converged flag.
+    DfsphDivergenceResidual,
+    /// DFSPH: v* = v + Δt a.
+    DfsphPredict,
+    /// DFSPH constant-density solve: reset, first predicted density errors.
+    DfsphDensityBegin,
+    /// One iteration: κ (summed for the pressure), the velocity correction,
+    /// the new errors.
+    DfsphDensityIterate,
+    /// The mean density error and the converged flag.
+    DfsphDensityResidual,
+    /// DFSPH: x += Δt v*, the step's pressure.
+    DfsphDrift,
 }
 
 /// What a scene has; it decides which stages and dispatches run.
@@ -97,6 +118,8 @@ pub struct Features {
     pub continuity: bool,
     /// A phase melts: liquidus crossings on cooling are recorded with |∇T|.
     pub solidification: bool,
+    /// Divergence-free SPH (implicit pressure).
+    pub dfsph: bool,
 }
 
 impl Features {
@@ -122,6 +145,7 @@ impl Features {
                 && params.solve.heat_integrator == HEAT_TRAPEZOIDAL,
             continuity: params.flag(FLAG_CONTINUITY),
             solidification: params.flag(FLAG_SOLIDIFICATION),
+            dfsph: params.solve.formulation == crate::scene::Formulation::Dfsph.code(),
         }
     }
 }
@@ -212,7 +236,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 20] = [
+pub const STAGES: [StageDef; 29] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -250,6 +274,133 @@ pub const STAGES: [StageDef; 20] = [
                 b.continuity_update()
             }),
         ],
+    },
+    StageDef {
+        stage: Stage::DfsphFactor,
+        name: "dfsph.factor",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        dispatches: &[
+            when(
+                "dfsph_boundary_volume",
+                Work::Particles,
+                |f| f.walls,
+                |b| b.dfsph_boundary_volume(),
+            ),
+            always("dfsph_factor", Work::Particles, |b| b.dfsph_factor()),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDivergenceBegin,
+        name: "dfsph.divergence_begin",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        // The warm start's κ applied to the velocities, then the errors again.
+        dispatches: &[
+            always("dfsph_divergence_begin", Work::Particles, |b| {
+                b.dfsph_begin(SolverSlot::Divergence)
+            }),
+            always("dfsph_divergence_warm_velocity", Work::Particles, |b| {
+                b.dfsph_velocity(SolverSlot::Divergence)
+            }),
+            always("dfsph_divergence_warm_error", Work::Particles, |b| {
+                b.dfsph_error(SolverSlot::Divergence)
+            }),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDivergenceIterate,
+        name: "dfsph.divergence_iterate",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        dispatches: &[
+            always("dfsph_divergence_kappa", Work::Particles, |b| {
+                b.dfsph_kappa(SolverSlot::Divergence)
+            }),
+            always("dfsph_divergence_velocity", Work::Particles, |b| {
+                b.dfsph_velocity(SolverSlot::Divergence)
+            }),
+            always("dfsph_divergence_error", Work::Particles, |b| {
+                b.dfsph_error(SolverSlot::Divergence)
+            }),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDivergenceResidual,
+        name: "dfsph.divergence_residual",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        // One twin for both levels of the sum tree.
+        dispatches: &[
+            always("dfsph_divergence_residual", Work::Reduction, |b| {
+                b.dfsph_residual(SolverSlot::Divergence)
+            }),
+            within("dfsph_divergence_residual_final", Work::Single),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphPredict,
+        name: "dfsph.predict",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        dispatches: &[always("dfsph_predict", Work::Particles, |b| {
+            b.dfsph_predict()
+        })],
+    },
+    StageDef {
+        stage: Stage::DfsphDensityBegin,
+        name: "dfsph.density_begin",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        // The warm start's κ applied to the velocities, then the errors again.
+        dispatches: &[
+            always("dfsph_density_begin", Work::Particles, |b| {
+                b.dfsph_begin(SolverSlot::Density)
+            }),
+            always("dfsph_density_warm_velocity", Work::Particles, |b| {
+                b.dfsph_velocity(SolverSlot::Density)
+            }),
+            always("dfsph_density_warm_error", Work::Particles, |b| {
+                b.dfsph_error(SolverSlot::Density)
+            }),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDensityIterate,
+        name: "dfsph.density_iterate",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        dispatches: &[
+            always("dfsph_density_kappa", Work::Particles, |b| {
+                b.dfsph_kappa(SolverSlot::Density)
+            }),
+            always("dfsph_density_velocity", Work::Particles, |b| {
+                b.dfsph_velocity(SolverSlot::Density)
+            }),
+            always("dfsph_density_error", Work::Particles, |b| {
+                b.dfsph_error(SolverSlot::Density)
+            }),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDensityResidual,
+        name: "dfsph.density_residual",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        // One twin for both levels of the sum tree.
+        dispatches: &[
+            always("dfsph_density_residual", Work::Reduction, |b| {
+                b.dfsph_residual(SolverSlot::Density)
+            }),
+            within("dfsph_density_residual_final", Work::Single),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphDrift,
+        name: "dfsph.drift",
+        file: "dfsph",
+        needed: |f| f.dfsph,
+        dispatches: &[always("dfsph_drift", Work::Particles, |b| b.dfsph_drift())],
     },
     StageDef {
         stage: Stage::Wall,

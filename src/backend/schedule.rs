@@ -22,10 +22,18 @@ use crate::scene::Formulation;
 pub enum SolverSlot {
     /// R18 Algorithm 3.1: the trapezoidal heat iteration.
     Heat = 0,
+    /// DFSPH's constant-density solve.
+    Density = 1,
+    /// DFSPH's divergence-free solve.
+    Divergence = 2,
 }
 
 /// Solver slots in the `solvers` buffer (every scene with a repeat holds them all).
-pub const SOLVER_SLOTS: [(SolverSlot, &str); 1] = [(SolverSlot::Heat, "heat")];
+pub const SOLVER_SLOTS: [(SolverSlot, &str); 3] = [
+    (SolverSlot::Heat, "heat"),
+    (SolverSlot::Density, "dfsph_density"),
+    (SolverSlot::Divergence, "dfsph_divergence"),
+];
 
 /// A bounded repeat: `begin` once (it resets its solver's slot), then up to
 /// `max_iterations` rounds of `stages`, the last of which sets the converged flag.
@@ -72,7 +80,7 @@ pub struct FormulationDef {
     pub schedule: fn(&Features, &Params) -> (Vec<Node>, Vec<Node>),
 }
 
-pub const FORMULATIONS: [FormulationDef; 2] = [
+pub const FORMULATIONS: [FormulationDef; 3] = [
     FormulationDef {
         formulation: Formulation::Wcsph,
         schedule: wcsph,
@@ -80,6 +88,10 @@ pub const FORMULATIONS: [FormulationDef; 2] = [
     FormulationDef {
         formulation: Formulation::DeltaWcsph,
         schedule: delta_wcsph,
+    },
+    FormulationDef {
+        formulation: Formulation::Dfsph,
+        schedule: dfsph,
     },
 ];
 
@@ -146,6 +158,68 @@ fn delta_wcsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
     // The density stage is `needed` by fluid alone: build with it, then swap.
     let (step, prime) = wcsph(f, p);
     (swap(step), swap(prime))
+}
+
+/// Divergence-free SPH (Bender & Koschier 2017 Algorithm 1, in SPlisHSPlasH's
+/// order; J22 Algorithm 1): the sort, density and factors, the divergence-free
+/// solve, the non-pressure forces and heat, v* = v + Δt a, the constant-density
+/// solve, the drift, the CFL step (the time step's acoustic limit without a
+/// sound speed). backend/cpu/dfsph.rs has the equations.
+const DFSPH_STEP: [Stage; 13] = [
+    Stage::Neighbors,
+    Stage::DfsphFactor,
+    Stage::DfsphDivergenceBegin, // a repeat (DFSPH_DIVERGENCE)
+    Stage::Interface,
+    Stage::Forces,
+    Stage::SurfaceForces,
+    Stage::Laser,
+    Stage::Heat,
+    Stage::Temperature,
+    Stage::DfsphPredict,
+    Stage::DfsphDensityBegin, // a repeat (DFSPH_DENSITY)
+    Stage::DfsphDrift,
+    Stage::Timestep,
+];
+
+fn dfsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
+    let repeat = |solver, begin, iterate, residual| {
+        Node::Repeat(Repeat {
+            solver,
+            begin,
+            stages: vec![iterate, residual],
+            max_iterations: p.solve.dfsph_max_iterations,
+        })
+    };
+    let step = DFSPH_STEP
+        .iter()
+        .filter(|s| needed(**s, f))
+        .map(|&s| match s {
+            Stage::DfsphDivergenceBegin => repeat(
+                SolverSlot::Divergence,
+                s,
+                Stage::DfsphDivergenceIterate,
+                Stage::DfsphDivergenceResidual,
+            ),
+            Stage::DfsphDensityBegin => repeat(
+                SolverSlot::Density,
+                s,
+                Stage::DfsphDensityIterate,
+                Stage::DfsphDensityResidual,
+            ),
+            Stage::Heat if f.implicit_heat => implicit_heat(p),
+            s => Node::Stage(s),
+        })
+        .collect();
+    let prime = [
+        Stage::Neighbors,
+        Stage::DfsphFactor,
+        Stage::Interface,
+        Stage::Forces,
+        Stage::SurfaceForces,
+        Stage::Temperature,
+        Stage::Timestep,
+    ];
+    (step, stage_nodes(&prime, f))
 }
 
 /// R18 Algorithm 3.1: the enthalpy update by the trapezoidal rule, solved
@@ -230,6 +304,7 @@ impl Pipeline {
             solvers: self.has_solvers(),
             continuity: f.continuity,
             solidification: f.solidification,
+            dfsph: f.dfsph,
         }
     }
     /// Leave `stage` out of every later step (bench throughput).

@@ -49,6 +49,10 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/free_rotation_3d"), &[]),
     (scene_file!("validation/hydrostatic_2d"), &["dx=0.025"]),
     (scene_file!("validation/hydrostatic_3d"), &["dx=0.025"]),
+    (
+        scene_file!("validation/hydrostatic_dfsph_2d"),
+        &["dx=0.025"],
+    ),
     (scene_file!("validation/jet_outflow_2d"), &[]),
     (scene_file!("validation/laplace_disc_2d"), &["dx=2e-3"]),
     (scene_file!("validation/laplace_free_disc_2d"), &["dx=2e-3"]),

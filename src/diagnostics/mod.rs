@@ -103,6 +103,61 @@ pub struct Diagnostics {
     /// beam below the initial surface, m (set by the run, which holds the track).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub depression_depth: Option<f64>,
+    /// Scenes with iterative solves (R18's trapezoidal heat, DFSPH's two
+    /// pressure solves): each solve's iterations and final residual in the
+    /// last step before the sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solvers: Option<std::collections::BTreeMap<String, SolverFigures>>,
+}
+
+/// One solve's figures of the last step (`State::solvers`).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct SolverFigures {
+    pub iterations: u32,
+    pub residual: f64,
+    /// The residual reached the tolerance (else the iteration bound stopped it).
+    pub converged: bool,
+}
+
+/// The solves the scene's schedule runs, by `SOLVER_SLOTS` name.
+pub fn solver_names(m: &Model) -> Vec<&'static str> {
+    use crate::backend::SolverSlot;
+    let trapezoidal =
+        m.is_thermal() && m.heat.integrator == crate::scene::HeatIntegrator::Trapezoidal;
+    let dfsph = m.formulation == crate::scene::Formulation::Dfsph;
+    crate::backend::SOLVER_SLOTS
+        .iter()
+        .filter(|(slot, _)| match slot {
+            SolverSlot::Heat => trapezoidal,
+            SolverSlot::Density | SolverSlot::Divergence => dfsph,
+        })
+        .map(|(_, name)| *name)
+        .collect()
+}
+
+fn solver_figures(
+    m: &Model,
+    st: &State,
+) -> Option<std::collections::BTreeMap<String, SolverFigures>> {
+    let names = solver_names(m);
+    if names.is_empty() || st.solvers.is_empty() {
+        return None;
+    }
+    Some(
+        crate::backend::SOLVER_SLOTS
+            .iter()
+            .filter(|(_, name)| names.contains(name))
+            .map(|(slot, name)| {
+                let s = st.solvers[*slot as usize];
+                let figures = SolverFigures {
+                    iterations: s.iterations,
+                    residual: s.residual as f64,
+                    converged: s.converged != 0,
+                };
+                (name.to_string(), figures)
+            })
+            .collect(),
+    )
 }
 
 /// The `/diagnostics` record of `st`, with its wall-leakage and outflow roll-ups;
@@ -126,6 +181,7 @@ pub fn record(m: &Model, st: &State) -> Diagnostics {
         heat: heat_diagnostics(m, st),
         surface: surface_diagnostics(m, st),
         depression_depth: None,
+        solvers: solver_figures(m, st),
     };
     let leak = Leakage::of(m, st);
     (d.wall_penetration_max_dx, d.wall_penetration_count) = (leak.deepest_dx, leak.beyond_half_dx);

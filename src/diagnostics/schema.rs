@@ -116,6 +116,20 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             schema["properties"][k] = num(&desc);
         }
     }
+    let solvers = super::solver_names(m);
+    if !solvers.is_empty() {
+        let one = serde_json::json!({"type": "object", "properties": {
+            "iterations": {"type": "integer", "description": "iterations in the last step"},
+            "residual": num("final residual of the last step"),
+            "converged": {"type": "boolean", "description": "the residual reached the tolerance (else the bound stopped it)"}
+        }});
+        let props: serde_json::Map<String, serde_json::Value> = solvers
+            .iter()
+            .map(|n| (n.to_string(), one.clone()))
+            .collect();
+        schema["properties"]["solvers"] = serde_json::json!({"type": "object", "properties": props,
+            "description": "each iterative solve's figures in the last step before the sample"});
+    }
     if crate::track::wanted(m) {
         schema["properties"]["depression_depth"] = num(
             "depth of the surface under the beam below the initial surface, m (> 0: sunk; absent while the beam is outside the domain)",

@@ -150,6 +150,8 @@ pub struct Model {
     pub viscosity_form: crate::scene::ViscosityForm,
     /// δ-SPH: what the density diffusion smooths (R18 (3.53) or the raw ρ).
     pub density_diffusion: crate::scene::DensityDiffusion,
+    /// DFSPH: the solves' tolerances and bound (defaults elsewhere).
+    pub dfsph: crate::scene::DfsphDef,
     pub limits: DtLimits,
 }
 
@@ -211,7 +213,12 @@ impl Model {
             (None, false) => DispersionAction::Stop,
         }
     }
+    /// The sound speed of the acoustic limit: none under DFSPH, whose
+    /// pressure is implicit (the flow's CFL limit 0.25 h/|u| remains).
     pub fn max_sound_speed(&self) -> f64 {
+        if self.formulation == crate::scene::Formulation::Dfsph {
+            return 0.0;
+        }
         self.phases
             .iter()
             .filter(|p| p.is_fluid())
@@ -439,7 +446,12 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             limit(t.heat_capacity, t.conductivity).min(limit(t.liquid.1, t.liquid.0))
         })
         .fold(f64::INFINITY, f64::min);
-    let c_max = fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max);
+    // DFSPH's pressure is implicit: no acoustic limit (the flow's CFL remains).
+    let c_max = if sim.formulation == crate::scene::Formulation::Dfsph {
+        0.0
+    } else {
+        fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max)
+    };
     let solid_fluid = solid_fluid_viscosity(&cx, sim, &phases)?;
     let nu_max = fluid.iter().map(|p| p.viscosity / p.rho0).fold(
         interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
@@ -606,6 +618,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     let stop_when_solidified = stop_when(&cx, run, laser.as_ref(), &phases)?;
     let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
     let delta = delta_coefficient(&cx, sim)?;
+    let dfsph = dfsph_def(&cx, scene)?;
     if delta.is_some() && sim.pressure_floor {
         warnings.push(format!(
             "{file}: key `simulation.pressure_floor`: on formulation = \"delta_wcsph\" the \
@@ -691,6 +704,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         delta,
         viscosity_form: sim.viscosity_form,
         density_diffusion: sim.density_diffusion,
+        dfsph,
         limits,
     })
 }
@@ -928,4 +942,59 @@ fn thermocapillary_layout(
         ));
     }
     Ok(())
+}
+
+/// `simulation.dfsph` and what DFSPH does not take yet.
+fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, InputError> {
+    let sim = &scene.simulation;
+    if sim.formulation != crate::scene::Formulation::Dfsph {
+        if sim.dfsph.is_some() {
+            return Err(cx.err("simulation.dfsph", "needs formulation = \"dfsph\""));
+        }
+        return Ok(crate::scene::DfsphDef::default());
+    }
+    let d = sim.dfsph.unwrap_or_default();
+    cx.positive("simulation.dfsph.density_tolerance", d.density_tolerance)?;
+    cx.positive(
+        "simulation.dfsph.divergence_tolerance",
+        d.divergence_tolerance,
+    )?;
+    if !(1..=200).contains(&d.max_iterations) {
+        return Err(cx.err(
+            "simulation.dfsph.max_iterations",
+            format!(
+                "must lie in 1..=200: the GPU records every iteration (got {})",
+                d.max_iterations
+            ),
+        ));
+    }
+    let refuse = |key: &str, why: &str| Err(cx.err(key, format!("formulation = \"dfsph\": {why}")));
+    if sim.pressure_floor {
+        return refuse(
+            "simulation.pressure_floor",
+            "its pressure is never negative (only compression is corrected); set it false",
+        );
+    }
+    if sim.initial_pressure != crate::scene::InitialPressure::Zero {
+        return refuse(
+            "simulation.initial_pressure",
+            "the fluid starts at rho0 and the solves give its pressure; set it \"zero\"",
+        );
+    }
+    if sim.background_pressure != 0.0 {
+        return refuse(
+            "simulation.background_pressure",
+            "no transport velocity yet; set it 0",
+        );
+    }
+    if scene.shapes.iter().any(|s| s.body) || scene.powder.as_ref().is_some_and(|p| p.rigid) {
+        return refuse("shapes", "no rigid bodies yet");
+    }
+    if let Some((name, _)) = scene.phases.iter().find(|(_, p)| p.moves) {
+        return refuse(
+            &format!("phases.{name}.moves"),
+            "its boundary particles do not move yet",
+        );
+    }
+    Ok(d)
 }

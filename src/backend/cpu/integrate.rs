@@ -48,7 +48,7 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
 /// w; the neighbour pass then sorts it last and the passes stop before it (issue
 /// 18). Walls are never removed.
 #[inline(always)]
-fn stamp_if_left(pr: &Params, x: &mut [f32; 4], left_at: f32) {
+pub(super) fn stamp_if_left(pr: &Params, x: &mut [f32; 4], left_at: f32) {
     if pr.outside_keep_box(x) {
         x[3] = left_at;
     }
@@ -56,7 +56,7 @@ fn stamp_if_left(pr: &Params, x: &mut [f32; 4], left_at: f32) {
 
 /// Brings coordinate `c` back into [0, period) on a periodic axis.
 #[inline(always)]
-fn wrap_periodic(pr: &Params, x: &mut [f32; 4], c: usize) {
+pub(super) fn wrap_periodic(pr: &Params, x: &mut [f32; 4], c: usize) {
     if pr.sizes.flags & (1 << c) != 0 {
         if x[c] >= pr.grid.period[c] {
             x[c] -= pr.grid.period[c];

@@ -5,6 +5,7 @@
 mod bodies;
 mod continuity;
 mod density;
+mod dfsph;
 mod forces;
 mod heat;
 mod integrate;
@@ -16,6 +17,7 @@ mod terms;
 mod timestep;
 mod wall;
 
+use super::schedule::SolverSlot;
 use super::{Backend, DeviceLost, Node, Pipeline, Stage, Twin};
 use crate::params::Params;
 use crate::state::{Sim, State};
@@ -77,6 +79,33 @@ impl CpuBackend {
     }
     pub(crate) fn density(&mut self) {
         density::run(&self.params, &mut self.st, &self.grid, &mut self.list)
+    }
+    pub(crate) fn dfsph_boundary_volume(&mut self) {
+        dfsph::boundary_volume(&self.params, &mut self.st)
+    }
+    pub(crate) fn dfsph_factor(&mut self) {
+        dfsph::factor(&self.params, &mut self.st, &self.grid, &mut self.list)
+    }
+    pub(crate) fn dfsph_begin(&mut self, slot: SolverSlot) {
+        dfsph::begin(&self.params, &mut self.st, &self.grid, slot)
+    }
+    pub(crate) fn dfsph_kappa(&mut self, slot: SolverSlot) {
+        dfsph::kappa(&self.params, &mut self.st, slot)
+    }
+    pub(crate) fn dfsph_velocity(&mut self, slot: SolverSlot) {
+        dfsph::velocity(&self.params, &mut self.st, &self.grid, slot)
+    }
+    pub(crate) fn dfsph_error(&mut self, slot: SolverSlot) {
+        dfsph::error(&self.params, &mut self.st, &self.grid, slot)
+    }
+    pub(crate) fn dfsph_residual(&mut self, slot: SolverSlot) {
+        dfsph::residual(&self.params, &mut self.st, slot)
+    }
+    pub(crate) fn dfsph_predict(&mut self) {
+        dfsph::predict(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn dfsph_drift(&mut self) {
+        dfsph::drift(&self.params, &mut self.st)
     }
     pub(crate) fn continuity_gradient(&mut self) {
         continuity::gradients(&self.params, &mut self.st, &self.grid)

@@ -37,13 +37,14 @@ const LIBS: [(&str, &str); 8] = [
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
-pub const PASSES: [(&str, &str); 12] = [
+pub const PASSES: [(&str, &str); 13] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     (
         "continuity",
         include_str!("../../../shaders/continuity.wgsl"),
     ),
+    ("dfsph", include_str!("../../../shaders/dfsph.wgsl")),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
     ("forces", include_str!("../../../shaders/forces.wgsl")),
     ("integrate", include_str!("../../../shaders/integrate.wgsl")),
@@ -374,6 +375,9 @@ mod tests {
     s_id[k] = id[s];
     if ((P.sizes.flags & FLAG_HEAT) != 0u) {
         s_heat[k] = heat[s];
+    }
+    if ((P.sizes.flags & FLAG_DFSPH) != 0u) {
+        s_dfsph_warm[k] = dfsph_warm[s];
     }
 ";
         assert_eq!(got, want);

@@ -95,6 +95,15 @@ fn dfsph_keys_are_checked() {
         ],
         "simulation.pressure_floor",
     );
+    common::assert_input_error(
+        &[
+            "validate",
+            &dfsph,
+            "--set",
+            "simulation.kernel=\"wendland_c2\"",
+        ],
+        "simulation.kernel",
+    );
     let out = common::spatter(&["validate", &dfsph]);
     let (o, e) = common::text(&out);
     assert_eq!(out.status.code(), Some(0), "{o}{e}");

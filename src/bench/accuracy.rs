@@ -589,7 +589,11 @@ fn formulation_table(runs: &[AccuracyRun]) -> Vec<String> {
         else {
             continue;
         };
+        // A run that failed (error NaN: stopped unstable) wins nothing.
         let cheaper = match (b.error <= v.error, b.wall_s <= v.wall_s) {
+            _ if !v.error.is_finite() && !b.error.is_finite() => "both failed".to_string(),
+            _ if !v.error.is_finite() => format!("{variant} failed"),
+            _ if !b.error.is_finite() => "as written failed".to_string(),
             (true, true) => "as written: smaller error in less time".to_string(),
             (false, false) => format!("{variant}: smaller error in less time"),
             (true, false) => "as written: smaller error, more time".to_string(),
@@ -738,5 +742,12 @@ mod tests {
             "{}",
             t[1]
         );
+        // A variant that stopped unstable (error NaN) wins nothing.
+        let failed = [
+            run("col", 8, 5.3e-3, 9.2),
+            run("col@dfsph", 8, f64::NAN, 0.1),
+        ];
+        let t = formulation_table(&failed);
+        assert!(t[0].ends_with("(dfsph failed)"), "{}", t[0]);
     }
 }

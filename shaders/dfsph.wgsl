@@ -1,14 +1,11 @@
-// uses: params consts kernel grid phase
-// reads: mass phase acc
+// uses: params consts kernel grid phase reduce
+// reads: mass phase acc heat
 // writes: pos vel rho press dfsph dfsph_warm solvers partials
 // Divergence-free SPH (Bender & Koschier 2015, 2017; J22 §3.1): the per-particle
 // factor, the divergence-free and constant-density solves (bounded repeats
 // whose residual sets the solver's converged flag), the full-step prediction
 // and drift, with Akinci et al. (2012) boundary volumes on the wall particles.
 // Twin of src/backend/cpu/dfsph.rs (equations and choices there).
-
-const DWG: u32 = 256u;
-var<workgroup> dred: array<vec2<f32>, 256>;
 
 // The wall's velocity (its phase's; walls do not move under DFSPH).
 fn boundary_velocity(j: u32) -> vec3<f32> {
@@ -151,53 +148,30 @@ fn apply_kappa(i: u32) {
     vel[i] = v;
 }
 
-// The solvers' residual: a fixed two-level tree sum of (error_i / rho0_i, 1)
-// over fluid particles (per workgroup, then one workgroup over the partials),
-// the same pairs the CPU twin adds.
-fn tree_sum(t: u32) {
-    for (var s = DWG / 2u; s > 0u; s = s / 2u) {
-        workgroupBarrier();
-        if (t < s) {
-            dred[t] = dred[t] + dred[t + s];
-        }
-    }
-    workgroupBarrier();
-}
-
+// The solvers' residual: the mean of max(error_i, 0) / rho0_i over fluid
+// particles by the fixed two-level tree (lib/reduce.wgsl).
 fn residual_level_one(t: u32, g: u32) {
     let i = g * DWG + t;
     var e = vec2<f32>(0.0, 0.0);
     if (i < active_particles() && !is_wall(phase[i])) {
         e = vec2<f32>(max(dfsph[i].y, 0.0) / P.phases[phase[i]].rho0, c_one());
     }
-    dred[t] = e;
-    tree_sum(t);
-    if (t == 0u) {
-        partials[g] = dred[0];
-    }
+    tree_level_one(t, g, e);
 }
 
 // The mean error over fluid particles (thread 0 holds it after the call).
 fn residual_level_two(t: u32) -> f32 {
-    let groups = (P.sizes.n_particles + DWG - 1u) / DWG;
-    var m = vec2<f32>(0.0, 0.0);
-    for (var g = t; g < groups; g += DWG) {
-        m = m + partials[g];
-    }
-    dred[t] = m;
-    tree_sum(t);
-    if (dred[0].y > 0.0) {
-        return dred[0].x / dred[0].y;
+    let total = tree_level_two(t);
+    if (total.y > 0.0) {
+        return total.x / total.y;
     }
     return 0.0;
 }
 
 fn finish_iteration(slot: u32, mean_error: f32, tolerance: f32, min_iterations: u32) {
-    var s = solvers[slot];
-    s.iterations = s.iterations + 1u;
-    s.residual = mean_error;
-    s.converged = select(0u, 1u, mean_error <= tolerance && s.iterations >= min_iterations);
-    solvers[slot] = s;
+    let s = solvers[slot];
+    let converged = mean_error <= tolerance && s.iterations + 1u >= min_iterations;
+    solvers[slot] = solver_finish(s, mean_error, converged, P.solve.dfsph_max_iterations);
 }
 
 fn divergence_converged() -> bool {
@@ -254,7 +228,7 @@ fn warm_start(i: u32, stored: f32, scale: f32) {
 fn dfsph_divergence_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i == 0u) {
-        solvers[SOLVER_DIVERGENCE] = Solver(0u, 0u, 0.0, 0u);
+        solvers[SOLVER_DIVERGENCE] = solver_reset(solvers[SOLVER_DIVERGENCE]);
     }
     if (i >= active_particles() || is_wall(phase[i])) { return; }
     divergence_error(i);
@@ -318,7 +292,7 @@ fn dfsph_divergence_residual_final(@builtin(local_invocation_index) t: u32) {
     finish_iteration(SOLVER_DIVERGENCE, mean * sim.dt, P.solve.dfsph_divergence_tolerance, 1u);
 }
 
-// v* = v + dt a (the non-pressure forces); the divergence solve's warm
+// v* = v + dt a (the non-pressure forces), then the mushy-zone sink; the divergence solve's warm
 // store dt sum(k).
 @compute @workgroup_size(64)
 fn dfsph_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -334,6 +308,14 @@ fn dfsph_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     v.x = v.x + dt * a.x - dt * b.x;
     v.y = v.y + dt * a.y - dt * b.y;
     v.z = v.z + dt * a.z - dt * b.z;
+    // The mushy-zone sink J22 (11)-(13), as the WCSPH kick has it.
+    let sink = P.phases[phase[i]].mushy_damping;
+    if (sink > 0.0) {
+        let damp = c_one() + dt * sink * (c_one() - heat[i][H_LIQUID]);
+        v.x = v.x / damp;
+        v.y = v.y / damp;
+        v.z = v.z / damp;
+    }
     vel[i] = v;
 }
 
@@ -368,7 +350,7 @@ fn wall_head(i: u32) -> vec3<f32> {
 fn dfsph_density_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i == 0u) {
-        solvers[SOLVER_DENSITY] = Solver(0u, 0u, 0.0, 0u);
+        solvers[SOLVER_DENSITY] = solver_reset(solvers[SOLVER_DENSITY]);
     }
     if (i >= active_particles() || is_wall(phase[i])) { return; }
     density_error(i);

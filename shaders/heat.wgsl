@@ -125,7 +125,7 @@ fn conduct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 fn heat_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (i == 0u) {
-        solvers[SOLVER_HEAT] = Solver(0u, 0u, 0.0, 0u);
+        solvers[SOLVER_HEAT] = solver_reset(solvers[SOLVER_HEAT]);
     }
     if (i >= active_particles()) { return; }
     if (conducts(phase[i])) {
@@ -232,17 +232,17 @@ fn heat_residual_final(@builtin(local_invocation_index) t: u32) {
     hred[t] = m;
     heat_tree_max(t);
     if (t != 0u) { return; }
-    var s = solvers[SOLVER_HEAT];
+    let s = solvers[SOLVER_HEAT];
+    var residual = 0.0;
     if (hred[0].y == 0.0) {
-        s.residual = 0.0;
+        residual = 0.0;
     } else if (s.iterations == 0u) {
-        s.residual = c_one();
+        residual = c_one();
     } else {
-        s.residual = hred[0].x / hred[0].y;
+        residual = hred[0].x / hred[0].y;
     }
-    s.iterations = s.iterations + 1u;
-    s.converged = select(0u, 1u, s.residual <= P.solve.heat_tolerance);
-    solvers[SOLVER_HEAT] = s;
+    solvers[SOLVER_HEAT] = solver_finish(s, residual, residual <= P.solve.heat_tolerance,
+        P.solve.heat_max_iterations);
 }
 
 // Evaporation F22 (18), (10) and radiation through the free surface, W/kg.

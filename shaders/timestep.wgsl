@@ -88,6 +88,10 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
             which = DT_FORCE;
         }
     }
+    if (P.time_step.maximum_limit < dt) {
+        dt = P.time_step.maximum_limit;
+        which = DT_MAXIMUM;
+    }
     if (P.time_step.fixed_dt > 0.0) {
         dt = P.time_step.fixed_dt;
         which = DT_FIXED;

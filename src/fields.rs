@@ -182,7 +182,7 @@ macro_rules! field {
 /// name, State array, binding, scratch, words per entry, entries per particle,
 /// float, holder, frame channels.
 #[rustfmt::skip]
-pub const FIELDS: [FieldDef; 19] = [
+pub const FIELDS: [FieldDef; 20] = [
     field!("position", pos, "pos", Some("s_pos"), 4, 1, true, Holder::Every,
         Some(output::position_channels)),
     field!("velocity", vel, "vel", Some("s_vel"), 4, 1, true, Holder::Every,
@@ -225,6 +225,9 @@ pub const FIELDS: [FieldDef; 19] = [
     // divergence solve), carried to the next step (sorted).
     field!("dfsph_warm", dfsph_warm, "dfsph_warm", Some("s_dfsph_warm"), 2, 1, true,
         Holder::Dfsph, None),
+    // DFSPH: the implicit viscosity's CG vectors (residual, direction, A times
+    // the direction, diag(A)), written from scratch every step after the sort.
+    field!("dfsph_cg", dfsph_cg, "dfsph_cg", None, 4, 4, true, Holder::Dfsph, None),
     // Written by heat.begin every step after the sort (no scratch needed).
     field!("heat_start", heat_start, "heat_start", None, 4, 1, true, Holder::ImplicitHeat,
         None),
@@ -278,7 +281,7 @@ pub const TABLES: [TableDef; 3] = [
     // Member particle ids, body after body.
     table!("members", members, 1, false, "u32", Holder::Bodies, 0),
     // One state::Solver per solver slot (backend::schedule::SOLVER_SLOTS).
-    table!("solvers", solvers, 4, false, "Solver", Holder::Solvers, 1),
+    table!("solvers", solvers, 8, false, "Solver", Holder::Solvers, 1),
 ];
 
 impl TableDef {

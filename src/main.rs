@@ -805,6 +805,9 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
             } else {
                 k.def().name
             };
+            if *k == Limit::Viscous && m.implicit_viscosity() {
+                return format!("{name} none (implicit: DFSPH's conjugate gradients)");
+            }
             format!("{name} {}", limit(*v))
         })
         .collect();

@@ -148,6 +148,8 @@ gpu_struct! {
         pub capillary_limit: f32,
         /// 0.22 √(m/k_c), the body contact limit (F22 (42)).
         pub contact_limit: f32,
+        /// `run.max_dt` (f32::MAX without it).
+        pub maximum_limit: f32,
     }
 }
 
@@ -342,6 +344,10 @@ gpu_struct! {
         pub program_frequency: f32,
         pub program_rate: f32,
         pub program_until: f32,
+        /// DFSPH's implicit viscosity (backend/cpu/dfsph_viscosity.rs): the
+        /// dynamic viscosity μ it solves with; `eta` is then 0 (the forces
+        /// pass has no explicit viscous term and the time step no viscous limit).
+        pub implicit_eta: f32,
         pub density: [DensityPoints; 2],
     }
 }
@@ -391,6 +397,17 @@ gpu_struct! {
         pub dfsph_divergence_tolerance: f32,
         /// DFSPH: each solve's bound.
         pub dfsph_max_iterations: u32,
+        /// DFSPH implicit viscosity: CG stops at |r| ≤ this × |r0|.
+        pub dfsph_viscosity_tolerance: f32,
+        /// DFSPH implicit viscosity: the CG repeat's bound.
+        pub dfsph_viscosity_max_iterations: u32,
+        /// DFSPH: J22 (14)'s XSPH factor α, solved with the viscosity.
+        pub dfsph_xsph: f32,
+        /// 0.01 h², Weiler et al. (2018)'s regularisation of 1/r².
+        pub dfsph_viscosity_eps: f32,
+        /// The implicit viscosity's form: 0 F22 (23) (Morris), 1 Weiler et
+        /// al. (2018) / R18 (3.18) (`viscosity_form = "marrone"`).
+        pub dfsph_viscosity_form: u32,
     }
 }
 
@@ -569,6 +586,7 @@ impl Params {
             barrier_limit: finite_or_max(m.limits.barrier),
             capillary_limit: finite_or_max(m.limits.capillary),
             contact_limit: finite_or_max(m.limits.contact),
+            maximum_limit: finite_or_max(m.limits.maximum),
         };
         p.flow = Flow {
             gravity: glam::Vec4::new(
@@ -588,6 +606,10 @@ impl Params {
         };
         for (i, ph) in m.phases.iter().enumerate() {
             p.phases[i] = phase_block(ph);
+            if m.implicit_viscosity() {
+                p.phases[i].implicit_eta = p.phases[i].eta;
+                p.phases[i].eta = 0.0;
+            }
         }
         p.laser = laser_block(m);
         if let Some(c) = m.contact.filter(|_| m.has_bodies()) {
@@ -614,6 +636,17 @@ impl Params {
             dfsph_density_tolerance: m.dfsph.density_tolerance as f32,
             dfsph_divergence_tolerance: m.dfsph.divergence_tolerance as f32,
             dfsph_max_iterations: m.dfsph.max_iterations,
+            dfsph_viscosity_tolerance: m.dfsph.viscosity_tolerance as f32,
+            // 0: no implicit solve (backend::passes::Features::dfsph_viscosity).
+            dfsph_viscosity_max_iterations: if m.implicit_viscosity() {
+                m.dfsph.viscosity_max_iterations
+            } else {
+                0
+            },
+            dfsph_xsph: m.dfsph.xsph as f32,
+            dfsph_viscosity_eps: (0.01 * m.h * m.h) as f32,
+            dfsph_viscosity_form: (m.viscosity_form == crate::scene::ViscosityForm::Marrone)
+                as u32,
         };
         if m.delta.is_some() {
             p.sizes.flags |= FLAG_CONTINUITY;
@@ -621,7 +654,7 @@ impl Params {
         if m.formulation == crate::scene::Formulation::Dfsph {
             p.sizes.flags |= FLAG_DFSPH;
         }
-        if m.viscosity_form == crate::scene::ViscosityForm::Marrone {
+        if m.viscosity_form == crate::scene::ViscosityForm::Marrone && m.delta.is_some() {
             p.sizes.flags |= FLAG_MARRONE_VISCOSITY;
         }
         if m.density_diffusion == crate::scene::DensityDiffusion::Raw {

@@ -446,6 +446,19 @@ pub struct DfsphDef {
     /// Iterations each solve may take per step (default 100, at most 200: the
     /// GPU records them all).
     pub max_iterations: u32,
+    /// "implicit" (default): the viscosity (Weiler et al. 2018) and XSPH are
+    /// one linear system solved by conjugate gradients after the explicit
+    /// forces (J22 (17)), so no viscous time-step limit; "explicit": the
+    /// forces pass's F22 (23) viscosity with its limit 0.125 h²/ν.
+    pub viscosity: DfsphViscosity,
+    /// The conjugate gradients stop at |r| ≤ this × |r0| (default 1e-3), r0
+    /// the viscous and XSPH impulse at v*.
+    pub viscosity_tolerance: f64,
+    /// Their bound per step (default 100, at most 200).
+    pub viscosity_max_iterations: u32,
+    /// J22 (14)'s XSPH factor α (default 0: off; J22 uses 0.3), solved with
+    /// the viscosity (needs `viscosity = "implicit"`).
+    pub xsph: f64,
 }
 
 impl Default for DfsphDef {
@@ -454,8 +467,20 @@ impl Default for DfsphDef {
             density_tolerance: 1.0e-3,
             divergence_tolerance: 1.0e-3,
             max_iterations: 100,
+            viscosity: DfsphViscosity::Implicit,
+            viscosity_tolerance: 1.0e-3,
+            viscosity_max_iterations: 100,
+            xsph: 0.0,
         }
     }
+}
+
+/// `simulation.dfsph.viscosity`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DfsphViscosity {
+    Implicit,
+    Explicit,
 }
 
 /// `simulation.barrier`: F22 (34) F = Σ_j (k_b g + d_b g ġ) e_ij over wall
@@ -729,6 +754,9 @@ pub struct RunDef {
     pub steps: Option<u64>,
     /// Fixed time step; absent means adaptive from the F22 (42) limits.
     pub dt: Option<f64>,
+    /// A cap on the adaptive time step (J22 Table 2a's "CFL max Δt"): DFSPH's
+    /// flow CFL grows without bound in a fluid at rest.
+    pub max_dt: Option<f64>,
     /// Simulated time between state samples (checks, output frames).
     pub output_interval: Option<f64>,
     /// Simulated time between `/diagnostics` messages and watchdog scans
@@ -925,6 +953,9 @@ pub enum CheckKind {
     /// R18 §5.1.1: a 2D powder-bed track's substrate penetration, peak
     /// temperature and speed beside R18's Table 5.3 at the run's power.
     R18Track,
+    /// J22 §4.1: a droplet's impact, mean vertical velocity through zero and
+    /// stop against J22's Fluent comparison; splat diameter and height.
+    Splat,
 }
 
 impl CheckKind {
@@ -960,6 +991,7 @@ impl CheckKind {
             CheckKind::ColumnExpansion => "column_expansion",
             CheckKind::PressureNoise => "pressure_noise",
             CheckKind::R18Track => "r18_track",
+            CheckKind::Splat => "splat",
         }
     }
 }

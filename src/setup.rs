@@ -355,6 +355,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     if held.dfsph {
         st.dfsph = vec![[0.0; 4]; st.len()];
         st.dfsph_warm = vec![[0.0; 2]; st.len()];
+        st.dfsph_cg = vec![[0.0; 4]; 4 * st.len()];
         // DFSPH corrects any density above ρ0, so a lattice whose summation
         // density is ρ0 (1 + ε) would be pushed apart at the first step (0.26%
         // for the quintic at h = Δx in 2D: the top of a 0.4 m column left at

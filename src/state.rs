@@ -22,7 +22,7 @@ pub struct Sim {
 }
 
 /// The limits' short names in code order (crate::model::limits::LIMITS).
-pub const DT_LIMIT_NAMES: [&str; 8] = crate::model::limits::LIMIT_NAMES;
+pub const DT_LIMIT_NAMES: [&str; 9] = crate::model::limits::LIMIT_NAMES;
 
 /// Name of the limit code the timestep pass wrote.
 pub fn dt_limit_name(code: u32) -> &'static str {
@@ -78,6 +78,9 @@ pub struct State {
     pub dfsph: Vec<[f32; 4]>,
     /// DFSPH only: the warm-start store (Δt² Σκ density, Δt Σκ divergence).
     pub dfsph_warm: Vec<[f32; 2]>,
+    /// DFSPH implicit viscosity's conjugate gradients, 4 per particle:
+    /// residual, direction, A times the direction, diag(A).
+    pub dfsph_cg: Vec<[f32; 4]>,
     /// Trapezoidal (Crank–Nicolson) heat only (empty otherwise): h^n, the laser
     /// source of the step, the first iteration's rate ḣ_0 and the last
     /// iteration's |ḣ_k − ḣ_{k−1}|.
@@ -97,7 +100,8 @@ pub struct State {
 }
 
 /// One solver's progress in the current step (WGSL twin `Solver` in
-/// shaders/lib/params.wgsl): reset by its repeat's begin stage.
+/// shaders/lib/params.wgsl): reset by its repeat's begin stage (all but
+/// `capped`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable, Default)]
 pub struct Solver {
@@ -105,7 +109,32 @@ pub struct Solver {
     /// 1 once the residual fell to the tolerance: the loop's kernels return at once.
     pub converged: u32,
     pub residual: f32,
-    pub _pad: u32,
+    /// Steps whose repeat ended at its bound unconverged, since the run
+    /// began (kept by the begin stage's reset; the run's warnings read it).
+    pub capped: u32,
+    /// A solver's own scalars across its iterations (the implicit viscosity's
+    /// conjugate gradients: r·z, r0·r0, step length, direction update).
+    pub scalars: [f32; 4],
+}
+
+impl Solver {
+    /// The begin stage's reset: a fresh count, the capped steps kept.
+    pub fn reset(&self) -> Solver {
+        Solver {
+            capped: self.capped,
+            ..Solver::default()
+        }
+    }
+    /// One iteration's end: the count, the residual and the converged flag;
+    /// a step that ends at the bound unconverged counts as capped.
+    pub fn finish(&mut self, residual: f32, converged: bool, max_iterations: u32) {
+        self.iterations += 1;
+        self.residual = residual;
+        self.converged = converged as u32;
+        if !converged && self.iterations >= max_iterations {
+            self.capped += 1;
+        }
+    }
 }
 
 /// Slots of the packed per-particle vectors (WGSL twins in lib/params.wgsl):

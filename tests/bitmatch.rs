@@ -842,18 +842,45 @@ fn powder_bed_of_1000_rigid_grains_200_steps() {
 
 const DFSPH: &str = "simulation.formulation=\"dfsph\"";
 
-/// Issue 30: DFSPH's factor, both solves (repeats: every iteration's
-/// dispatches, the tree-summed residuals, the converged flags), the walls'
-/// head, predict and drift: a 2D dam break (free surface, walls) and a 3D
-/// one, with a bound of 20 iterations so the recorded passes stay few.
+/// Issue 30: a DFSPH droplet with heat hits a cold free-slip wall (J22's
+/// Fluent case, 2D at Δx = 4 µm): the implicit viscosity with XSPH, the
+/// conduction into the Dirichlet wall and the mushy-zone sink as the melt
+/// freezes, 150 steps (the impact at about 100).
+#[test]
+fn dfsph_spray_droplet_150_steps() {
+    let path = format!(
+        "{}/scenarios/spray/j22_fluent_case_2d.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    assert_bit_identical_at(
+        &path,
+        &[
+            "dx=4e-6",
+            "simulation.dfsph={ xsph = 0.3, max_iterations = 20, viscosity_max_iterations = 20 }",
+        ],
+        150,
+    );
+}
+
+/// Issue 30: DFSPH's factor, both pressure solves and the implicit viscosity
+/// with XSPH (repeats: every iteration's dispatches, the tree-summed
+/// residuals and dot products, the converged flags), the walls' head and
+/// no-slip velocities, predict and drift: a 2D dam break (free surface,
+/// walls) and a 3D one, with a bound of 20 iterations so the recorded passes
+/// stay few; the Poiseuille channel with Weiler's projected viscosity.
 #[test]
 fn dfsph_dam_break_2d_and_3d_200_steps() {
     let sets = [
         DFSPH,
         "simulation.pressure_floor=false",
         "simulation.initial_pressure=\"zero\"",
-        "simulation.dfsph={ max_iterations = 20 }",
+        "simulation.dfsph={ max_iterations = 20, viscosity_max_iterations = 20, xsph = 0.3 }",
     ];
+    assert_bit_identical(
+        "poiseuille_dfsph_2d",
+        &["simulation.viscosity_form=\"marrone\""],
+        20,
+    );
     let mut with_dx = sets.to_vec();
     with_dx.push("dx=0.005");
     assert_bit_identical("dam_break_2d", &with_dx, 200);

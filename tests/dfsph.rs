@@ -1,13 +1,15 @@
 //! Divergence-free SPH (issue 30): the hydrostatic column holds its pressure,
-//! the solves stop at their tolerance, and DFSPH's keys are refused where they
-//! do not apply. Bit-match on lavapipe is in tests/bitmatch.rs.
+//! the implicit viscosity gives Poiseuille's profile at 100× the explicit
+//! step, the solves stop at their tolerance, and DFSPH's keys are refused
+//! where they do not apply. Bit-match on lavapipe is in tests/bitmatch.rs.
 
 mod common;
 
 /// hydrostatic_dfsph_2d: p within 2% rms of ρ g (H − y) (the check's tolerance,
-/// J22's "pressure within 2%"), measured 1.2% at the default tolerance; each
-/// `/diagnostics` record carries both solves' iterations and residuals, and at
-/// rest both end at their tolerance (the density solve after at least two).
+/// J22's "pressure within 2%"), measured 0.51% at the scene's tolerances;
+/// each `/diagnostics` record carries the three solves' iterations and
+/// residuals, and at rest all end at their tolerance (the density solve after
+/// at least two).
 #[test]
 fn hydrostatic_column_holds_its_pressure_within_2_percent() {
     let mcap = common::scratch("dfsph_column").join("column.mcap");
@@ -35,7 +37,7 @@ fn hydrostatic_column_holds_its_pressure_within_2_percent() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!(value < 0.015, "{line}: measured 1.2% when this landed");
+    assert!(value < 0.01, "{line}: measured 0.51% when this landed");
     let bytes = std::fs::read(&mcap).unwrap();
     let last: serde_json::Value = mcap::MessageStream::new(&bytes)
         .unwrap()
@@ -49,8 +51,67 @@ fn hydrostatic_column_holds_its_pressure_within_2_percent() {
     assert_eq!(density["converged"], true, "{last}");
     assert_eq!(divergence["converged"], true, "{last}");
     assert!(density["iterations"].as_u64().unwrap() >= 2, "{last}");
-    assert!(density["residual"].as_f64().unwrap() <= 1.0e-3, "{last}");
+    assert!(density["residual"].as_f64().unwrap() <= 5.0e-4, "{last}");
     assert!(divergence["residual"].as_f64().unwrap() <= 1.0e-3, "{last}");
+    let viscosity = &last["solvers"]["dfsph_viscosity"];
+    assert_eq!(viscosity["converged"], true, "{last}");
+    assert!(viscosity["residual"].as_f64().unwrap() <= 1.0e-3, "{last}");
+}
+
+/// poiseuille_dfsph_2d: the implicit viscosity (F22 (23)'s form solved by
+/// conjugate gradients) at a fixed step 100× the explicit limit 0.125 h²/ν
+/// (64 steps where the explicit one needs 6 400) within 2% of the series
+/// solution (the check's tolerance, issue 2's); measured 0.17%. Weiler et
+/// al.'s projected form (`viscosity_form = "marrone"`, J22 (17)'s) is 0.83× the
+/// Laplacian at h = Δx with the quintic (terms/marrone_viscosity.rs) and
+/// measures 18%: it is reported, not asserted to pass.
+#[test]
+fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
+    let scene = common::scene("poiseuille_dfsph_2d");
+    // A check that fails exits 1.
+    let run = |sets: &[&str], code: i32| {
+        let mut args = vec!["run", scene.as_str(), "--backend", "cpu"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let out = common::spatter(&args);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(code), "{o}{e}");
+        o
+    };
+    let o = run(&[], 0);
+    assert!(o.contains("steps: 64,"), "{o}");
+    let line = o
+        .lines()
+        .find(|l| l.starts_with("check poiseuille"))
+        .expect(&o);
+    assert!(line.ends_with("PASS"), "{line}");
+    let value: f64 = line.split(" = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(value < 0.005, "{line}: measured 0.17% when this landed");
+    let o = run(&["simulation.viscosity_form=\"marrone\""], 1);
+    let line = o.lines().find(|l| l.starts_with("check poiseuille")).expect(&o);
+    println!("Weiler / Marrone form: {line}");
+}
+
+/// scenarios/spray/j22_fluent_case_2d (J22's Fluent comparison, 2D coarse):
+/// impact, mean vertical velocity through zero and stop within 15% of J22's
+/// 0.5, 1.0 and 2.0 µs (the check's tolerance, issue 30's); measured 3.6%
+/// (0.501, 0.964, 1.95 µs). The splat spreads (a cylinder: 3.55 D0).
+#[test]
+fn spray_droplet_impact_matches_j22_timings() {
+    let out = common::spatter(&[
+        "run",
+        &common::scene_at("spray/j22_fluent_case_2d"),
+        "--backend",
+        "cpu",
+    ]);
+    let (o, e) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{o}{e}");
+    let line = o.lines().find(|l| l.starts_with("check splat")).expect(&o);
+    assert!(line.ends_with("PASS"), "{o}");
+    let summary = o.lines().find(|l| l.contains("spread factor")).expect(&o);
+    let xi: f64 = summary.rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(xi > 2.0, "{summary}: the splat must spread");
 }
 
 /// The solves' keys need the formulation, and DFSPH refuses what it does not
@@ -95,6 +156,37 @@ fn dfsph_keys_are_checked() {
         ],
         "simulation.pressure_floor",
     );
+    for (set, key) in [
+        ("simulation.dfsph.xsph=1.5", "simulation.dfsph.xsph"),
+        (
+            "simulation.dfsph.viscosity_max_iterations=0",
+            "simulation.dfsph.viscosity_max_iterations",
+        ),
+        (
+            "simulation.dfsph.viscosity_tolerance=-1.0",
+            "simulation.dfsph.viscosity_tolerance",
+        ),
+        (
+            "simulation.dfsph={ viscosity = \"explicit\", xsph = 0.3 }",
+            "simulation.dfsph.xsph",
+        ),
+        ("run.dt=1e-3", "run.max_dt"),
+        ("run.max_dt=0.0", "run.max_dt"),
+    ] {
+        common::assert_input_error(&["validate", &dfsph, "--set", set], key);
+    }
+    // Weiler's form is the implicit solve's option only.
+    common::assert_input_error(
+        &[
+            "validate",
+            &dfsph,
+            "--set",
+            "simulation.dfsph.viscosity=\"explicit\"",
+            "--set",
+            "simulation.viscosity_form=\"marrone\"",
+        ],
+        "simulation.viscosity_form",
+    );
     common::assert_input_error(
         &[
             "validate",
@@ -112,7 +204,12 @@ fn dfsph_keys_are_checked() {
         "{o}"
     );
     assert!(
-        o.contains("passes: neighbors, dfsph, forces, timestep"),
+        o.contains("repeat <= 100 until converged [dfsph.viscosity_apply"),
+        "{o}"
+    );
+    assert!(o.contains("viscous none (implicit"), "{o}");
+    assert!(
+        o.contains("passes: neighbors, dfsph, dfsph_viscosity, forces, timestep"),
         "{o}"
     );
 }

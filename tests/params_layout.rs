@@ -311,7 +311,7 @@ fn a_member_renamed_or_moved_on_one_side_is_reported() {
     let wgsl = wgsl_layout(&moved, "Params").unwrap();
     assert!(mismatches(&rust, &wgsl.lines).is_empty());
     let bad = probe(&wgsl);
-    assert_eq!(bad.len(), 7, "every time_step member: {bad:?}");
+    assert_eq!(bad.len(), 8, "every time_step member: {bad:?}");
     assert!(bad.iter().all(|l| l.starts_with("time_step.")), "{bad:?}");
     // An array's stride changed in WGSL only (PathPoint without its alignment:
     // 12 bytes): the first element is in place, the next ones are not.

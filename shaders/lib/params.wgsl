@@ -36,6 +36,7 @@ struct TimeStep {
     barrier_limit: f32,      // 0.22 sqrt(m/k_b)
     capillary_limit: f32,    // 0.25 sqrt(rho h^3/(2 pi alpha))
     contact_limit: f32,      // 0.22 sqrt(m/k_c)
+    maximum_limit: f32,      // run.max_dt
 }
 
 struct Flow {
@@ -119,6 +120,11 @@ struct Solve {                // the formulation and its solvers (backend::sched
     dfsph_density_tolerance: f32,     // DFSPH: mean (rho* - rho0)/rho0
     dfsph_divergence_tolerance: f32,  // DFSPH: mean dt max(D rho/Dt, 0)/rho0
     dfsph_max_iterations: u32,
+    dfsph_viscosity_tolerance: f32,   // DFSPH implicit viscosity: CG stops at |r| <= this |r0|
+    dfsph_viscosity_max_iterations: u32,
+    dfsph_xsph: f32,                  // J22 (14) alpha
+    dfsph_viscosity_eps: f32,         // 0.01 h^2
+    dfsph_viscosity_form: u32,        // 0 F22 (23) (Morris), 1 Weiler 2018 / R18 (3.18)
 }
 
 struct Phase {
@@ -157,6 +163,7 @@ struct Phase {
     program_frequency: f32,
     program_rate: f32,
     program_until: f32,
+    implicit_eta: f32,       // DFSPH implicit viscosity's mu (eta is then 0)
     density: array<DensityPoints, 2>,
 }
 
@@ -243,7 +250,26 @@ struct Solver {
     iterations: u32,         // iterations run since the repeat began
     converged: u32,          // 1: the residual fell to the tolerance; the loop's kernels return
     residual: f32,           // the last iteration's residual
-    pad0: u32,
+    capped: u32,             // steps ended at the bound unconverged (kept by the reset)
+    scalars: vec4<f32>,      // a solver's own scalars (conjugate gradients: r.z, r0.r0, alpha, beta)
+}
+
+// The begin stage's reset of a solver's slot (twin of Solver::reset).
+fn solver_reset(s: Solver) -> Solver {
+    return Solver(0u, 0u, 0.0, s.capped, vec4<f32>(0.0));
+}
+
+// One iteration's end (twin of Solver::finish): count, residual, converged
+// flag; a step ended at the bound unconverged counts as capped.
+fn solver_finish(s: Solver, residual: f32, converged: bool, max_iterations: u32) -> Solver {
+    var t = s;
+    t.iterations = t.iterations + 1u;
+    t.residual = residual;
+    t.converged = select(0u, 1u, converged);
+    if (!converged && t.iterations >= max_iterations) {
+        t.capped = t.capped + 1u;
+    }
+    return t;
 }
 
 // One rigid body: twin of src/state.rs `Body` (world frame, grid-relative).
@@ -300,6 +326,7 @@ const HEAT_TRAPEZOIDAL: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;
 const SOLVER_DENSITY: u32 = 1u;
 const SOLVER_DIVERGENCE: u32 = 2u;
+const SOLVER_VISCOSITY: u32 = 3u;
 // Slots of the packed per-particle vectors (src/state.rs, same names): heat[i]
 // is (h, T, f_l, dh/dt); surface[i] is (normal xyz, delta) and surface[n + i]
 // (Shepard sum, curvature, raw curvature, -).
@@ -328,4 +355,5 @@ const DT_CONDUCTION: u32 = 4u;
 const DT_BARRIER: u32 = 5u;
 const DT_CAPILLARY: u32 = 6u;
 const DT_CONTACT: u32 = 7u;
+const DT_MAXIMUM: u32 = 8u;
 const WG: u32 = 64u;

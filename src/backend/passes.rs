@@ -83,6 +83,17 @@ pub enum Stage {
     DfsphDensityResidual,
     /// DFSPH: x += Δt v*, the step's pressure.
     DfsphDrift,
+    /// DFSPH implicit viscosity: the walls' no-slip velocities from the
+    /// fluid's velocity before the explicit forces.
+    DfsphViscosityWall,
+    /// DFSPH implicit viscosity and XSPH (J22 (17)): CG's residual,
+    /// preconditioner and first direction at x0 = v*, the solver reset.
+    DfsphViscosityBegin,
+    /// One CG product q = A p and the step length.
+    DfsphViscosityApply,
+    /// The CG update of v and r, the residual and converged flag, the next
+    /// direction.
+    DfsphViscosityUpdate,
 }
 
 /// What a scene has; it decides which stages and dispatches run.
@@ -120,6 +131,8 @@ pub struct Features {
     pub solidification: bool,
     /// Divergence-free SPH (implicit pressure).
     pub dfsph: bool,
+    /// DFSPH with the implicit viscosity and XSPH solve.
+    pub dfsph_viscosity: bool,
 }
 
 impl Features {
@@ -146,6 +159,9 @@ impl Features {
             continuity: params.flag(FLAG_CONTINUITY),
             solidification: params.flag(FLAG_SOLIDIFICATION),
             dfsph: params.solve.formulation == crate::scene::Formulation::Dfsph.code(),
+            dfsph_viscosity: params.solve.formulation
+                == crate::scene::Formulation::Dfsph.code()
+                && params.solve.dfsph_viscosity_max_iterations > 0,
         }
     }
 }
@@ -236,7 +252,7 @@ pub struct StageDef {
 
 /// Every stage, listed pass file by pass file in the order `spatter validate`
 /// prints them.
-pub const STAGES: [StageDef; 29] = [
+pub const STAGES: [StageDef; 33] = [
     StageDef {
         stage: Stage::Neighbors,
         name: "neighbors",
@@ -393,6 +409,56 @@ pub const STAGES: [StageDef; 29] = [
                 b.dfsph_residual(SolverSlot::Density)
             }),
             within("dfsph_density_residual_final", Work::Single),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphViscosityWall,
+        name: "dfsph.viscosity_wall",
+        file: "dfsph_viscosity",
+        needed: |f| f.dfsph_viscosity && f.walls,
+        dispatches: &[always("dfsph_viscosity_wall", Work::Particles, |b| {
+            b.dfsph_viscosity_wall()
+        })],
+    },
+    StageDef {
+        stage: Stage::DfsphViscosityBegin,
+        name: "dfsph.viscosity_begin",
+        file: "dfsph_viscosity",
+        needed: |f| f.dfsph_viscosity,
+        // One twin for the sweep and both levels of the sum tree.
+        dispatches: &[
+            always("dfsph_viscosity_begin", Work::Particles, |b| {
+                b.dfsph_viscosity_begin()
+            }),
+            within("dfsph_viscosity_begin_sum", Work::Reduction),
+            within("dfsph_viscosity_begin_final", Work::Single),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphViscosityApply,
+        name: "dfsph.viscosity_apply",
+        file: "dfsph_viscosity",
+        needed: |f| f.dfsph_viscosity,
+        dispatches: &[
+            always("dfsph_viscosity_apply", Work::Particles, |b| {
+                b.dfsph_viscosity_apply()
+            }),
+            within("dfsph_viscosity_apply_sum", Work::Reduction),
+            within("dfsph_viscosity_apply_final", Work::Single),
+        ],
+    },
+    StageDef {
+        stage: Stage::DfsphViscosityUpdate,
+        name: "dfsph.viscosity_update",
+        file: "dfsph_viscosity",
+        needed: |f| f.dfsph_viscosity,
+        dispatches: &[
+            always("dfsph_viscosity_update", Work::Particles, |b| {
+                b.dfsph_viscosity_update()
+            }),
+            within("dfsph_viscosity_update_sum", Work::Reduction),
+            within("dfsph_viscosity_update_final", Work::Single),
+            within("dfsph_viscosity_direction", Work::Particles),
         ],
     },
     StageDef {

@@ -26,13 +26,16 @@ pub enum SolverSlot {
     Density = 1,
     /// DFSPH's divergence-free solve.
     Divergence = 2,
+    /// DFSPH's implicit viscosity (conjugate gradients).
+    Viscosity = 3,
 }
 
 /// Solver slots in the `solvers` buffer (every scene with a repeat holds them all).
-pub const SOLVER_SLOTS: [(SolverSlot, &str); 3] = [
+pub const SOLVER_SLOTS: [(SolverSlot, &str); 4] = [
     (SolverSlot::Heat, "heat"),
     (SolverSlot::Density, "dfsph_density"),
     (SolverSlot::Divergence, "dfsph_divergence"),
+    (SolverSlot::Viscosity, "dfsph_viscosity"),
 ];
 
 /// A bounded repeat: `begin` once (it resets its solver's slot), then up to
@@ -162,10 +165,11 @@ fn delta_wcsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
 
 /// Divergence-free SPH (Bender & Koschier 2017 Algorithm 1, in SPlisHSPlasH's
 /// order; J22 Algorithm 1): the sort, density and factors, the divergence-free
-/// solve, the non-pressure forces and heat, v* = v + Δt a, the constant-density
+/// solve, the non-pressure forces and heat, v* = v + Δt a, the implicit
+/// viscosity and XSPH (J22 (17), conjugate gradients), the constant-density
 /// solve, the drift, the CFL step (the time step's acoustic limit without a
-/// sound speed). backend/cpu/dfsph.rs has the equations.
-const DFSPH_STEP: [Stage; 13] = [
+/// sound speed). backend/cpu/dfsph.rs and dfsph_viscosity.rs have the equations.
+const DFSPH_STEP: [Stage; 15] = [
     Stage::Neighbors,
     Stage::DfsphFactor,
     Stage::DfsphDivergenceBegin, // a repeat (DFSPH_DIVERGENCE)
@@ -175,7 +179,9 @@ const DFSPH_STEP: [Stage; 13] = [
     Stage::Laser,
     Stage::Heat,
     Stage::Temperature,
+    Stage::DfsphViscosityWall,
     Stage::DfsphPredict,
+    Stage::DfsphViscosityBegin, // a repeat (conjugate gradients)
     Stage::DfsphDensityBegin, // a repeat (DFSPH_DENSITY)
     Stage::DfsphDrift,
     Stage::Timestep,
@@ -206,6 +212,12 @@ fn dfsph(f: &Features, p: &Params) -> (Vec<Node>, Vec<Node>) {
                 Stage::DfsphDensityIterate,
                 Stage::DfsphDensityResidual,
             ),
+            Stage::DfsphViscosityBegin => Node::Repeat(Repeat {
+                solver: SolverSlot::Viscosity,
+                begin: s,
+                stages: vec![Stage::DfsphViscosityApply, Stage::DfsphViscosityUpdate],
+                max_iterations: p.solve.dfsph_viscosity_max_iterations,
+            }),
             Stage::Heat if f.implicit_heat => implicit_heat(p),
             s => Node::Stage(s),
         })

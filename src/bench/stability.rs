@@ -76,6 +76,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         scene_file!("validation/poiseuille_2d"),
         &["dx=6.666666666666667e-5"],
     ),
+    (scene_file!("validation/poiseuille_dfsph_2d"), &[]),
     (scene_file!("validation/powder_bed_at_rest_2d"), &[]),
     (scene_file!("validation/recoil_layer_2d"), &[]),
     (scene_file!("validation/rosenthal_2d"), &["dx=5e-5"]),
@@ -108,6 +109,8 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=1e-5"],
     ),
     (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
+    (scene_file!("spray/j22_fluent_case_2d"), &[]),
+    (scene_file!("spray/j22_fluent_case_3d"), &[]),
 ];
 
 /// The long runs `--quick` keeps (one per kind of physics).
@@ -682,10 +685,10 @@ mod every_scene {
     use super::LONG_RUNS;
 
     /// "Long runs of every validation and process scene": each scene file under
-    /// scenarios/validation and scenarios/pbf has a LONG_RUNS row.
+    /// scenarios/validation, scenarios/pbf and scenarios/spray has a LONG_RUNS row.
     #[test]
     fn every_validation_and_process_scene_has_a_long_run() {
-        for dir in ["validation", "pbf"] {
+        for dir in ["validation", "pbf", "spray"] {
             let path = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
             for entry in std::fs::read_dir(&path).unwrap() {
                 let name = entry.unwrap().file_name().into_string().unwrap();

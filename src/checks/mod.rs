@@ -9,7 +9,8 @@
 //! thermocapillary.rs (Marangoni flow in a two-layer channel), bodies.rs (rigid
 //! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
 //! expansion.rs (δ-SPH thermal expansion: R18 Tests 1, 2 and 3), noise.rs (pressure
-//! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track).
+//! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track), splat.rs
+//! (J22's droplet impact timings and splat size).
 
 mod bodies;
 mod compression;
@@ -19,6 +20,7 @@ mod flow;
 mod heat;
 mod noise;
 mod solidification;
+mod splat;
 mod tension;
 pub mod thermocapillary;
 mod track;
@@ -167,6 +169,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         }
         CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
         CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
+        CheckKind::Splat => Box::new(splat::Splat::default()),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

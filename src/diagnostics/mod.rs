@@ -104,8 +104,8 @@ pub struct Diagnostics {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub depression_depth: Option<f64>,
     /// Scenes with iterative solves (R18's trapezoidal heat, DFSPH's two
-    /// pressure solves): each solve's iterations and final residual in the
-    /// last step before the sample.
+    /// pressure solves and implicit viscosity): each solve's iterations and
+    /// final residual in the last step before the sample.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solvers: Option<std::collections::BTreeMap<String, SolverFigures>>,
 }
@@ -117,6 +117,8 @@ pub struct SolverFigures {
     pub residual: f64,
     /// The residual reached the tolerance (else the iteration bound stopped it).
     pub converged: bool,
+    /// Steps since the run began that this solve ended at its bound unconverged.
+    pub capped_steps: u32,
 }
 
 /// The solves the scene's schedule runs, by `SOLVER_SLOTS` name.
@@ -130,6 +132,7 @@ pub fn solver_names(m: &Model) -> Vec<&'static str> {
         .filter(|(slot, _)| match slot {
             SolverSlot::Heat => trapezoidal,
             SolverSlot::Density | SolverSlot::Divergence => dfsph,
+            SolverSlot::Viscosity => m.implicit_viscosity(),
         })
         .map(|(_, name)| *name)
         .collect()
@@ -153,6 +156,7 @@ fn solver_figures(
                     iterations: s.iterations,
                     residual: s.residual as f64,
                     converged: s.converged != 0,
+                    capped_steps: s.capped,
                 };
                 (name.to_string(), figures)
             })

@@ -121,7 +121,8 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         let one = serde_json::json!({"type": "object", "properties": {
             "iterations": {"type": "integer", "description": "iterations in the last step"},
             "residual": num("final residual of the last step"),
-            "converged": {"type": "boolean", "description": "the residual reached the tolerance (else the bound stopped it)"}
+            "converged": {"type": "boolean", "description": "the residual reached the tolerance (else the bound stopped it)"},
+            "capped_steps": {"type": "integer", "description": "steps since the run began that ended at the bound unconverged"}
         }});
         let props: serde_json::Map<String, serde_json::Value> = solvers
             .iter()

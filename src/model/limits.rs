@@ -17,6 +17,7 @@ pub enum Limit {
     Barrier = 5,
     Capillary = 6,
     Contact = 7,
+    Maximum = 8,
 }
 
 pub struct LimitDef {
@@ -28,7 +29,7 @@ pub struct LimitDef {
 }
 
 /// Every limit, in code order.
-pub const LIMITS: [LimitDef; 8] = [
+pub const LIMITS: [LimitDef; 9] = [
     LimitDef {
         limit: Limit::Acoustic,
         name: "acoustic",
@@ -76,6 +77,12 @@ pub const LIMITS: [LimitDef; 8] = [
         name: "contact",
         label: "contact 0.22 sqrt(m/k_c)",
         wgsl: "DT_CONTACT",
+    },
+    LimitDef {
+        limit: Limit::Maximum,
+        name: "maximum",
+        label: "maximum run.max_dt",
+        wgsl: "DT_MAXIMUM",
     },
 ];
 

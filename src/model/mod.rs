@@ -51,12 +51,14 @@ pub struct DtLimits {
     pub capillary: f64,
     /// F22 (42) 0.22 √(m/k_c) with the lightest body particle; ∞ without bodies.
     pub contact: f64,
+    /// `run.max_dt` (J22 Table 2a's "CFL max Δt"); ∞ without it.
+    pub maximum: f64,
 }
 
 impl DtLimits {
     /// The scene's constant limits with their rows of `limits::LIMITS` (∞ where
     /// the scene lacks the physics; the force limit here is gravity's).
-    pub fn rows(&self) -> [(limits::Limit, f64); 7] {
+    pub fn rows(&self) -> [(limits::Limit, f64); 8] {
         use limits::Limit;
         [
             (Limit::Acoustic, self.acoustic),
@@ -66,6 +68,7 @@ impl DtLimits {
             (Limit::Barrier, self.barrier),
             (Limit::Capillary, self.capillary),
             (Limit::Contact, self.contact),
+            (Limit::Maximum, self.maximum),
         ]
     }
     /// The smallest limit and its label (the first of equal ones).
@@ -212,6 +215,11 @@ impl Model {
             (None, true) => DispersionAction::Warn,
             (None, false) => DispersionAction::Stop,
         }
+    }
+    /// DFSPH with its implicit viscosity and XSPH solve.
+    pub fn implicit_viscosity(&self) -> bool {
+        self.formulation == crate::scene::Formulation::Dfsph
+            && self.dfsph.viscosity == crate::scene::DfsphViscosity::Implicit
     }
     /// The sound speed of the acoustic limit: none under DFSPH, whose
     /// pressure is implicit (the flow's CFL limit 0.25 h/|u| remains).
@@ -453,7 +461,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max)
     };
     let solid_fluid = solid_fluid_viscosity(&cx, sim, &phases)?;
-    let nu_max = fluid.iter().map(|p| p.viscosity / p.rho0).fold(
+    // DFSPH's implicit viscosity has no time-step limit (the artificial
+    // viscosities stay explicit).
+    let implicit_viscosity = sim.formulation == crate::scene::Formulation::Dfsph
+        && sim.dfsph.unwrap_or_default().viscosity == crate::scene::DfsphViscosity::Implicit;
+    let nu_max = fluid
+        .iter()
+        .filter(|_| !implicit_viscosity)
+        .map(|p| p.viscosity / p.rho0)
+        .fold(
         interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
             + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
         f64::max,
@@ -495,6 +511,13 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 .sqrt()
         }),
         contact: bodies::contact_limit(&bodies, &phases, contact),
+        maximum: match scene.run.max_dt {
+            Some(_) if scene.run.dt.is_some() => {
+                return Err(cx.err("run.max_dt", "give dt (fixed) or max_dt (a cap), not both"));
+            }
+            Some(v) => cx.positive("run.max_dt", v)?,
+            None => f64::INFINITY,
+        },
     };
 
     let run = &scene.run;
@@ -733,9 +756,17 @@ fn delta_coefficient(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Option<
             "simulation.density_diffusion",
             "is the δ-SPH density diffusion's form: set formulation = \"delta_wcsph\" or leave it out",
         )),
+        (Formulation::Dfsph, None)
+            if sim.viscosity_form == crate::scene::ViscosityForm::Marrone
+                && sim.dfsph.unwrap_or_default().viscosity
+                    == crate::scene::DfsphViscosity::Implicit =>
+        {
+            Ok(None)
+        }
         _ if sim.viscosity_form != crate::scene::ViscosityForm::Morris => Err(cx.err(
             "simulation.viscosity_form",
-            "\"marrone\" is R18 (3.18), built for formulation = \"delta_wcsph\" only",
+            "\"marrone\" is R18 (3.18) (Weiler et al. 2018's in J22 (17)), built for \
+             formulation = \"delta_wcsph\" and for the implicit viscosity of \"dfsph\" only",
         )),
         (_, Some(_)) => Err(cx.err(
             "simulation.delta",
@@ -959,6 +990,28 @@ fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, Inpu
         "simulation.dfsph.divergence_tolerance",
         d.divergence_tolerance,
     )?;
+    if !(1..=200).contains(&d.viscosity_max_iterations) {
+        return Err(cx.err(
+            "simulation.dfsph.viscosity_max_iterations",
+            format!(
+                "must lie in 1..=200: the GPU records every iteration (got {})",
+                d.viscosity_max_iterations
+            ),
+        ));
+    }
+    cx.positive("simulation.dfsph.viscosity_tolerance", d.viscosity_tolerance)?;
+    if !(d.xsph.is_finite() && (0.0..=1.0).contains(&d.xsph)) {
+        return Err(cx.err(
+            "simulation.dfsph.xsph",
+            format!("must lie in [0, 1] (J22: 0.1 to 0.3), got {}", d.xsph),
+        ));
+    }
+    if d.xsph > 0.0 && d.viscosity == crate::scene::DfsphViscosity::Explicit {
+        return Err(cx.err(
+            "simulation.dfsph.xsph",
+            "is solved with the implicit viscosity: set viscosity = \"implicit\"",
+        ));
+    }
     if !(1..=200).contains(&d.max_iterations) {
         return Err(cx.err(
             "simulation.dfsph.max_iterations",

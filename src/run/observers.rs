@@ -70,6 +70,13 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     if m.melts() {
         list.push(Box::<SolidificationRecords>::default());
     }
+    let solves = crate::diagnostics::solver_names(m);
+    if !solves.is_empty() && !opts.quiet {
+        list.push(Box::new(SolverCaps {
+            last: None,
+            solves,
+        }));
+    }
     if m.watchdog.enabled
         && m.dispersion_action() == crate::scene::DispersionAction::Warn
         && !opts.quiet
@@ -96,6 +103,53 @@ impl Observer for DispersionWarning {
                 d.describe(m)
             );
         }
+    }
+}
+
+/// Iterative solves that stop at their bound instead of their tolerance: a
+/// warning at each sample after which two or more steps since the previous
+/// one ended capped, naming the solve, its bound and its last residual.
+struct SolverCaps {
+    /// The step and each slot's capped count at the previous sample.
+    last: Option<(u32, Vec<u32>)>,
+    solves: Vec<&'static str>,
+}
+
+impl Observer for SolverCaps {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        if st.solvers.is_empty() {
+            return;
+        }
+        let now: Vec<u32> = st.solvers.iter().map(|s| s.capped).collect();
+        let sample = matches!(when, Moment::Sample { .. } | Moment::Final);
+        if let (true, Some((step0, before))) = (sample, self.last.as_ref()) {
+            let steps = st.sim.step.saturating_sub(*step0);
+            for (slot, name) in crate::backend::SOLVER_SLOTS.iter() {
+                let k = *slot as usize;
+                let capped = now[k].saturating_sub(before[k]);
+                if capped >= 2 && self.solves.contains(name) {
+                    eprintln!(
+                        "warning: t = {:.6e} s: the {name} solve stopped at its bound of {} \
+                         iterations unconverged on {capped} of the {steps} steps since the last \
+                         sample (last residual {:.3e}); raise its max_iterations or loosen its tolerance",
+                        st.sim.time as f64,
+                        max_iterations(m, *slot),
+                        st.solvers[k].residual
+                    );
+                }
+            }
+        }
+        self.last = Some((st.sim.step, now));
+    }
+}
+
+/// A solve's bound of iterations per step.
+fn max_iterations(m: &Model, slot: crate::backend::SolverSlot) -> u32 {
+    use crate::backend::SolverSlot;
+    match slot {
+        SolverSlot::Heat => m.heat.max_iterations,
+        SolverSlot::Density | SolverSlot::Divergence => m.dfsph.max_iterations,
+        SolverSlot::Viscosity => m.dfsph.viscosity_max_iterations,
     }
 }
 

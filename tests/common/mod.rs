@@ -27,6 +27,11 @@ pub fn scene(name: &str) -> String {
     )
 }
 
+/// A scene file by its path under scenarios/ (e.g. "spray/j22_fluent_case_2d").
+pub fn scene_at(path: &str) -> String {
+    format!("{}/scenarios/{path}.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
 /// The Python with tools/requirements.txt installed: $SPATTER_PYTHON, else the
 /// repository's .venv that tools/test.sh sets up.
 pub fn python() -> std::path::PathBuf {

@@ -49,17 +49,15 @@
 //!   boundaries, moving walls and rigid bodies.
 
 use super::integrate::{stamp_if_left, wrap_periodic};
+use super::reduce::tree_total;
 use super::neighbors::{
     for_each_neighbor, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
 use crate::backend::schedule::SolverSlot;
 use crate::kernel;
 use crate::params::Params;
-use crate::state::{Solver, State};
+use crate::state::{State, H_LIQUID};
 use rayon::prelude::*;
-
-/// Threads per workgroup of the residual's tree (`DWG` in the WGSL).
-const DWG: usize = 256;
 
 /// `dfsph_boundary_volume`: V_b = m_b / ρ0_b in dfsph.x of each wall
 /// particle; its pressure 0.
@@ -240,7 +238,7 @@ fn errors(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
 /// (divergence; K = Δt Σκ) where the particle is compressed now, else 0, in
 /// dfsph.z (the stage's velocity and error dispatches apply it) and dfsph.w.
 pub fn begin(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
-    st.solvers[slot as usize] = Solver::default();
+    st.solvers[slot as usize] = st.solvers[slot as usize].reset();
     errors(pr, st, grid, slot);
     let dt = st.sim.dt;
     for i in fluid(pr, st) {
@@ -297,41 +295,15 @@ pub fn error(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
     errors(pr, st, grid, slot);
 }
 
-/// One workgroup's tree: s = 128, 64, ..., 1, red[t] += red[t + s].
-fn tree_sum(red: &mut [[f32; 2]; DWG]) -> [f32; 2] {
-    let mut s = DWG / 2;
-    while s > 0 {
-        for t in 0..s {
-            red[t] = [red[t][0] + red[t + s][0], red[t][1] + red[t + s][1]];
-        }
-        s /= 2;
-    }
-    red[0]
-}
-
 /// The mean error over fluid particles by the GPU's two-level tree.
 fn mean_error(pr: &Params, st: &State) -> f32 {
-    let n = pr.n();
-    let groups = n.div_ceil(DWG);
-    let partials: Vec<[f32; 2]> = (0..groups)
-        .map(|g| {
-            let mut red = [[0.0f32; 2]; DWG];
-            for (t, e) in red.iter_mut().enumerate() {
-                let i = g * DWG + t;
-                if i < st.active() && !pr.is_wall(st.phase[i]) {
-                    *e = [st.dfsph[i][1].max(0.0) / pr.phase(st.phase[i]).rho0, 1.0];
-                }
-            }
-            tree_sum(&mut red)
-        })
-        .collect();
-    let mut red = [[0.0f32; 2]; DWG];
-    for (t, m) in red.iter_mut().enumerate() {
-        for p in partials.iter().skip(t).step_by(DWG) {
-            *m = [m[0] + p[0], m[1] + p[1]];
+    let total = tree_total(pr.n(), |i| {
+        if i < st.active() && !pr.is_wall(st.phase[i]) {
+            [st.dfsph[i][1].max(0.0) / pr.phase(st.phase[i]).rho0, 1.0]
+        } else {
+            [0.0, 0.0]
         }
-    }
-    let total = tree_sum(&mut red);
+    });
     if total[1] > 0.0 {
         total[0] / total[1]
     } else {
@@ -351,9 +323,8 @@ pub fn residual(pr: &Params, st: &mut State, slot: SolverSlot) {
         _ => (mean, pr.solve.dfsph_density_tolerance, 2),
     };
     let s = &mut st.solvers[slot as usize];
-    s.iterations += 1;
-    s.residual = value;
-    s.converged = (value <= tolerance && s.iterations >= min_iterations) as u32;
+    let converged = value <= tolerance && s.iterations + 1 >= min_iterations;
+    s.finish(value, converged, pr.solve.dfsph_max_iterations);
 }
 
 /// The walls' hydrostatic head (Adami et al. 2012's extrapolation, the part
@@ -380,8 +351,8 @@ fn wall_head(pr: &Params, st: &State, grid: &CellTable, i: usize) -> [f32; 3] {
     h
 }
 
-/// `dfsph_predict`: v* = v + Δt (a − the walls' head); the divergence
-/// solve's store Δt Σκ.
+/// `dfsph_predict`: v* = v + Δt (a − the walls' head), then the mushy-zone
+/// sink v*/(1 + Δt C (1 − f_l)); the divergence solve's store Δt Σκ.
 pub fn predict(pr: &Params, st: &mut State, grid: &CellTable) {
     let dt = st.sim.dt;
     let s: &State = st;
@@ -392,9 +363,18 @@ pub fn predict(pr: &Params, st: &mut State, grid: &CellTable) {
     for (i, b) in heads {
         st.dfsph_warm[i][1] = dt * st.dfsph[i][3];
         let a = st.acc[i];
+        let sink = pr.phase(st.phase[i]).mushy_damping;
+        let liquid = if sink > 0.0 { st.heat[i][H_LIQUID] } else { 1.0 };
         let v = &mut st.vel[i];
         for c in 0..3 {
             v[c] = v[c] + dt * a[c] - dt * b[c];
+        }
+        // The mushy-zone sink J22 (11)–(13), as the WCSPH kick has it.
+        if sink > 0.0 {
+            let damp = 1.0 + dt * sink * (1.0 - liquid);
+            for c in v.iter_mut().take(3) {
+                *c /= damp;
+            }
         }
     }
 }

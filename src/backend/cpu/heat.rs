@@ -31,7 +31,7 @@ use crate::params::{
     HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
-use crate::state::{Solver, State, BODY_SOLIDIFIED};
+use crate::state::{State, BODY_SOLIDIFIED};
 use crate::state::{H_ENTHALPY, H_LIQUID, H_RATE, H_TEMPERATURE, S_DELTA};
 use crate::state::{SOL_COOLING, SOL_COUNT, SOL_GRADIENT, SOL_PENDING, SOL_TIME};
 use rayon::prelude::*;
@@ -195,7 +195,8 @@ pub fn begin(pr: &Params, st: &mut State) {
                 [0.0; 4]
             };
         });
-    st.solvers[SolverSlot::Heat as usize] = Solver::default();
+    let slot = &mut st.solvers[SolverSlot::Heat as usize];
+    *slot = slot.reset();
 }
 
 /// The heat solver's flag: the loop's twins return at once once it is set.
@@ -274,15 +275,18 @@ pub fn residual(pr: &Params, st: &mut State) {
         })
         .reduce(|| (0.0f32, 0.0f32), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     let s = &mut st.solvers[SolverSlot::Heat as usize];
-    s.residual = if smax == 0.0 {
+    let residual = if smax == 0.0 {
         0.0
     } else if s.iterations == 0 {
         1.0
     } else {
         dmax / smax
     };
-    s.iterations += 1;
-    s.converged = (s.residual <= pr.solve.heat_tolerance) as u32;
+    s.finish(
+        residual,
+        residual <= pr.solve.heat_tolerance,
+        pr.solve.heat_max_iterations,
+    );
 }
 
 /// Heat lost through the free surface per unit mass (W/kg): evaporation F22 (18)

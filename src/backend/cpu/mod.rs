@@ -6,12 +6,14 @@ mod bodies;
 mod continuity;
 mod density;
 mod dfsph;
+mod dfsph_viscosity;
 mod forces;
 mod heat;
 mod integrate;
 mod interface;
 mod laser;
 mod neighbors;
+mod reduce;
 mod surface_forces;
 mod terms;
 mod timestep;
@@ -103,6 +105,18 @@ impl CpuBackend {
     }
     pub(crate) fn dfsph_predict(&mut self) {
         dfsph::predict(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn dfsph_viscosity_wall(&mut self) {
+        dfsph_viscosity::wall_velocities(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn dfsph_viscosity_begin(&mut self) {
+        dfsph_viscosity::begin(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn dfsph_viscosity_apply(&mut self) {
+        dfsph_viscosity::apply(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn dfsph_viscosity_update(&mut self) {
+        dfsph_viscosity::update(&self.params, &mut self.st)
     }
     pub(crate) fn dfsph_drift(&mut self) {
         dfsph::drift(&self.params, &mut self.st)

@@ -70,6 +70,10 @@ pub fn next_dt(pr: &Params, umax2: f32, amax2: f32) -> (f32, u32) {
             which = Limit::Force;
         }
     }
+    if pr.time_step.maximum_limit < dt {
+        dt = pr.time_step.maximum_limit;
+        which = Limit::Maximum;
+    }
     if pr.time_step.fixed_dt > 0.0 {
         dt = pr.time_step.fixed_dt;
         which = Limit::Fixed;

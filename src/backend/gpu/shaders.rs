@@ -25,7 +25,7 @@ use crate::params::Params;
 use std::collections::HashMap;
 
 /// Library files, in the order they are composed (each after what it uses).
-const LIBS: [(&str, &str); 8] = [
+const LIBS: [(&str, &str); 9] = [
     ("params", include_str!("../../../shaders/lib/params.wgsl")),
     ("consts", include_str!("../../../shaders/lib/consts.wgsl")),
     ("math", include_str!("../../../shaders/lib/math.wgsl")),
@@ -34,10 +34,11 @@ const LIBS: [(&str, &str); 8] = [
     ("phase", include_str!("../../../shaders/lib/phase.wgsl")),
     ("vapour", include_str!("../../../shaders/lib/vapour.wgsl")),
     ("rigid", include_str!("../../../shaders/lib/rigid.wgsl")),
+    ("reduce", include_str!("../../../shaders/lib/reduce.wgsl")),
 ];
 
 /// The pass files (one per compute pass, named as in the pass table).
-pub const PASSES: [(&str, &str); 13] = [
+pub const PASSES: [(&str, &str); 14] = [
     ("neighbors", include_str!("../../../shaders/neighbors.wgsl")),
     ("density", include_str!("../../../shaders/density.wgsl")),
     (
@@ -45,6 +46,10 @@ pub const PASSES: [(&str, &str); 13] = [
         include_str!("../../../shaders/continuity.wgsl"),
     ),
     ("dfsph", include_str!("../../../shaders/dfsph.wgsl")),
+    (
+        "dfsph_viscosity",
+        include_str!("../../../shaders/dfsph_viscosity.wgsl"),
+    ),
     ("wall", include_str!("../../../shaders/wall.wgsl")),
     ("forces", include_str!("../../../shaders/forces.wgsl")),
     ("integrate", include_str!("../../../shaders/integrate.wgsl")),

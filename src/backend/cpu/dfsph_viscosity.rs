@@ -1,0 +1,300 @@
+//! Twin of shaders/dfsph_viscosity.wgsl: DFSPH's implicit velocity system,
+//! J22 (17) without its cohesion and adhesion terms: Weiler et al. (2018)'s
+//! viscosity (J22 (4)) and XSPH (J22 (14)) solved together for v^{t+1} by
+//! matrix-free conjugate gradients (Jacobi preconditioned), after v* = v +
+//! Δt a (the explicit forces) and before the constant-density solve.
+//!
+//! - The system, multiplied by m_i so that the matrix is symmetric:
+//!   m_i v_i + Σ_j [k_ij x_ij (x_ij·(v_i − v_j)) + s_ij (v_i − v_j)] = m_i v*_i,
+//!   k_ij = −Δt 2(d+2) μ_ij V_i V_j (∂W/∂r / r) / (r² + 0.01 h²) ≥ 0 and
+//!   s_ij = α m_i m_j W_ij / ρ̄_ij ≥ 0 (ρ̄ the mean, α J22's XSPH factor).
+//!   Its pair blocks are positive semi-definite and the masses make it
+//!   positive definite, so CG converges.
+//! - μ_ij = 2 μ_i μ_j / (μ_i + μ_j) (the explicit viscosity's mean); J22 has
+//!   one fluid. XSPH takes m_j / ρ̄_ij where J22 has m̄_ij / ρ̄_ij (the same for
+//!   one material): with it the matrix stays symmetric and the pair impulses
+//!   stay equal and opposite.
+//! - Walls (multi-layer, volume V_b of the factor pass): no-slip, the
+//!   viscosity pair against Adami et al. (2012)'s extrapolated wall velocity
+//!   u_b = 2 u_w − ũ_b, ũ_b from the fluid's velocity before the explicit
+//!   forces (a constant part of the right side, lagged by one step); none
+//!   against a free-slip wall phase (`free_slip`). No XSPH against walls (J22
+//!   (14) sums over the fluid). With u_b = u_w instead, the fluid saw three
+//!   layers at rest and the Poiseuille channel ran 14.5% fast; with ũ_b from
+//!   v* = v + Δt a the wall moved at −Δt a and at Δt = 100× the explicit
+//!   limit the channel ran 13% fast.
+//! - CG from x0 = v*: r = b − A x0 = −Σ_j (pair terms at v*), z = r / diag(A),
+//!   p = z; each iteration q = A p, α = r·z / p·q, v += α p, r −= α q,
+//!   β = r·z_new / r·z, p = z + β p. Dot products by the fixed tree
+//!   (super::reduce). Converged when |r| ≤ tolerance |r0| (the viscous and
+//!   XSPH impulse at v*), |·| the Euclidean norm over all fluid components;
+//!   at once when r0 = 0 (no viscosity, no XSPH). Against |b| = |m v*|
+//!   instead, a column at rest (v* = Δt g everywhere, the viscous part 1% of
+//!   it) stopped after 2 iterations with its noise modes half solved, and its
+//!   pressure error swung between 20% and 150% (0.5-1.8% with the explicit
+//!   viscosity).
+//! - Scalars in the solver's slot: r·z, r0·r0, α, β.
+//! - Left out: J22's cohesion (15) and adhesion (16) terms.
+
+use super::neighbors::{for_each_neighbor, CellTable};
+use super::reduce::tree_total;
+use super::terms::pair_viscosity;
+use crate::backend::schedule::SolverSlot;
+use crate::kernel;
+use crate::params::{Params, PHASE_FREE_SLIP};
+use crate::state::{Solver, State};
+use rayon::prelude::*;
+
+const SLOT: usize = SolverSlot::Viscosity as usize;
+/// Entries of `dfsph_cg` per particle: residual r, direction p, A p, diag(A).
+const R: usize = 0;
+const P: usize = 1;
+const Q: usize = 2;
+const DIAG: usize = 3;
+
+/// The pair's coefficients (k_p, k_i, s) for fluid particle i and neighbour j
+/// at r² = r2: the projected viscosity's −k_ij (Weiler; `viscosity_form =
+/// "marrone"`) or the isotropic one's (F22 (23)), both ≤ 0, and XSPH's s_ij.
+fn pair(pr: &Params, st: &State, i: usize, j: usize, vol_i: f32, r2: f32) -> [f32; 3] {
+    let r = r2.sqrt();
+    let g = kernel::dw(pr, r) / r;
+    let mu_i = pr.phase(st.phase[i]).implicit_eta;
+    let ph_j = st.phase[j];
+    let wall = pr.is_wall(ph_j);
+    let (mu, vol_j) = if wall {
+        let slip = pr.phase(ph_j).flags & PHASE_FREE_SLIP != 0;
+        (pair_viscosity(mu_i, mu_i, slip), st.dfsph[j][0])
+    } else {
+        let mu = pair_viscosity(mu_i, pr.phase(ph_j).implicit_eta, false);
+        (mu, st.mass[j] / st.rho[j])
+    };
+    let dt = st.sim.dt;
+    let (mut kp, mut ki) = (0.0f32, 0.0f32);
+    if pr.solve.dfsph_viscosity_form == 1 {
+        let f = dt * pr.solve.viscosity_factor;
+        kp = f * mu * vol_i * vol_j * g / (r2 + pr.solve.dfsph_viscosity_eps);
+    } else {
+        ki = dt * mu * (vol_i * vol_i + vol_j * vol_j) * g;
+    }
+    let mut s = 0.0f32;
+    if !wall {
+        let (rho_i, rho_j) = (st.rho[i], st.rho[j]);
+        s = pr.solve.dfsph_xsph * st.mass[i] * st.mass[j] * kernel::w(pr, r)
+            / ((rho_i + rho_j) * 0.5);
+    }
+    [kp, ki, s]
+}
+
+/// Σ_j [−k_p x_ij (x_ij·u_ij) − k_i u_ij + s_ij u_ij] over i's neighbours,
+/// u_ij the difference of `field` (a wall's value: `wall`), and the
+/// diagonal m_i + Σ_j (−k_p x_ij,a² − k_i + s_ij).
+fn sweep(
+    pr: &Params,
+    st: &State,
+    grid: &CellTable,
+    i: usize,
+    field: impl Fn(usize) -> [f32; 3],
+    wall: impl Fn(usize) -> [f32; 3],
+) -> ([f32; 3], [f32; 3]) {
+    let m_i = st.mass[i];
+    let vol_i = m_i / st.rho[i];
+    let f_i = field(i);
+    let mut acc = [0.0f32; 3];
+    let mut dg = [m_i, m_i, m_i];
+    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
+        if r2 <= 0.0 {
+            return;
+        }
+        let [kp, ki, s] = pair(pr, st, i, j, vol_i, r2);
+        let f_j = if pr.is_wall(st.phase[j]) {
+            wall(j)
+        } else {
+            field(j)
+        };
+        let u = [f_i[0] - f_j[0], f_i[1] - f_j[1], f_i[2] - f_j[2]];
+        let c = kp * (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]);
+        for a in 0..3 {
+            acc[a] = acc[a] - c * d[a] - ki * u[a] + s * u[a];
+            dg[a] = dg[a] - kp * d[a] * d[a] - ki + s;
+        }
+    });
+    (acc, dg)
+}
+
+fn fluid(pr: &Params, st: &State) -> Vec<usize> {
+    (0..st.active())
+        .filter(|&i| !pr.is_wall(st.phase[i]))
+        .collect()
+}
+
+fn converged(st: &State) -> bool {
+    st.solvers[SLOT].converged != 0
+}
+
+fn xyz(v: [f32; 4]) -> [f32; 3] {
+    [v[0], v[1], v[2]]
+}
+
+fn dot(a: [f32; 4], b: [f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// z = r / diag(A).
+fn precondition(cg: &[[f32; 4]], i: usize) -> [f32; 4] {
+    let (r, dg) = (cg[4 * i + R], cg[4 * i + DIAG]);
+    [r[0] / dg[0], r[1] / dg[1], r[2] / dg[2], 0.0]
+}
+
+/// A dot product of fluid entries by the tree (0 elsewhere).
+fn tree_dot(pr: &Params, st: &State, value: impl Fn(usize) -> [f32; 2] + Sync) -> [f32; 2] {
+    tree_total(pr.n(), |i| {
+        if i < st.active() && !pr.is_wall(st.phase[i]) {
+            value(i)
+        } else {
+            [0.0, 0.0]
+        }
+    })
+}
+
+/// `dfsph_viscosity_wall` (before v* = v + Δt a): each wall particle's
+/// no-slip velocity in its dfsph_cg[4 b] (Adami et al. 2012, as the wall
+/// pass: u_b = 2 u_w − ũ_b, ũ_b the Shepard mean of the fluid's v over its
+/// neighbours, the divisor Σ W + ε).
+pub fn wall_velocities(pr: &Params, st: &mut State, grid: &CellTable) {
+    let s: &State = st;
+    let rows: Vec<(usize, [f32; 4])> = (0..s.active())
+        .into_par_iter()
+        .filter(|&b| pr.is_wall(s.phase[b]))
+        .map(|b| {
+            let (mut sw, mut sv) = (0.0f32, [0.0f32; 3]);
+            for_each_neighbor(pr, &s.pos, grid, b, |j, _, r2| {
+                if pr.is_wall(s.phase[j]) {
+                    return;
+                }
+                let wk = kernel::w(pr, r2.sqrt());
+                sw += wk;
+                let v = s.vel[j];
+                for a in 0..3 {
+                    sv[a] += v[a] * wk;
+                }
+            });
+            let u = pr.phase(s.phase[b]).velocity.to_array();
+            let den = sw + pr.flow.wall_weight_floor;
+            let v = [
+                u[0] + (u[0] * sw - sv[0]) / den,
+                u[1] + (u[1] * sw - sv[1]) / den,
+                u[2] + (u[2] * sw - sv[2]) / den,
+                0.0,
+            ];
+            (b, v)
+        })
+        .collect();
+    for (b, v) in rows {
+        st.dfsph_cg[4 * b + R] = v;
+    }
+}
+
+/// `dfsph_viscosity_begin` and its sums: r, diag(A), p = z at x0 = v*; the
+/// solver reset with r·z and r0·r0, converged at once when r·z = 0.
+pub fn begin(pr: &Params, st: &mut State, grid: &CellTable) {
+    let s: &State = st;
+    let rows: Vec<(usize, [f32; 3], [f32; 3])> = fluid(pr, s)
+        .into_par_iter()
+        .map(|i| {
+            let (acc, dg) = sweep(pr, s, grid, i, |j| xyz(s.vel[j]), |j| {
+                xyz(s.dfsph_cg[4 * j + R])
+            });
+            (i, acc, dg)
+        })
+        .collect();
+    for (i, acc, dg) in rows {
+        // Negated, not 0 − acc: lavapipe folds 0 − x into −x (−0 at x = 0).
+        st.dfsph_cg[4 * i + R] = [-acc[0], -acc[1], -acc[2], 0.0];
+        st.dfsph_cg[4 * i + DIAG] = [dg[0], dg[1], dg[2], 0.0];
+        st.dfsph_cg[4 * i + P] = precondition(&st.dfsph_cg, i);
+    }
+    let s: &State = st;
+    let [rz, rr] = tree_dot(pr, s, |i| {
+        let r = s.dfsph_cg[4 * i + R];
+        [dot(r, s.dfsph_cg[4 * i + P]), dot(r, r)]
+    });
+    st.solvers[SLOT] = Solver {
+        converged: (rz <= 0.0) as u32,
+        scalars: [rz, rr, 0.0, 0.0],
+        ..st.solvers[SLOT].reset()
+    };
+}
+
+/// `dfsph_viscosity_apply` (and its sums): q = A p, α = r·z / p·q.
+pub fn apply(pr: &Params, st: &mut State, grid: &CellTable) {
+    if converged(st) {
+        return;
+    }
+    let s: &State = st;
+    let rows: Vec<(usize, [f32; 3])> = fluid(pr, s)
+        .into_par_iter()
+        .map(|i| {
+            let (acc, _) = sweep(pr, s, grid, i, |j| xyz(s.dfsph_cg[4 * j + P]), |_| {
+                [0.0; 3]
+            });
+            (i, acc)
+        })
+        .collect();
+    for (i, acc) in rows {
+        let m = st.mass[i];
+        let p = st.dfsph_cg[4 * i + P];
+        st.dfsph_cg[4 * i + Q] = [m * p[0] + acc[0], m * p[1] + acc[1], m * p[2] + acc[2], 0.0];
+    }
+    let s: &State = st;
+    let [pq, _] = tree_dot(pr, s, |i| {
+        [dot(s.dfsph_cg[4 * i + P], s.dfsph_cg[4 * i + Q]), 0.0]
+    });
+    let sc = &mut st.solvers[SLOT].scalars;
+    sc[2] = if pq > 0.0 { sc[0] / pq } else { 0.0 };
+}
+
+/// `dfsph_viscosity_update` (its sums, the residual and the new direction):
+/// v += α p, r −= α q; β, the relative residual |r|/|r0| and the converged
+/// flag; p = z + β p.
+pub fn update(pr: &Params, st: &mut State) {
+    if converged(st) {
+        return;
+    }
+    let alpha = st.solvers[SLOT].scalars[2];
+    for i in fluid(pr, st) {
+        let (p, q) = (st.dfsph_cg[4 * i + P], st.dfsph_cg[4 * i + Q]);
+        let v = &mut st.vel[i];
+        let r = &mut st.dfsph_cg[4 * i + R];
+        for a in 0..3 {
+            v[a] += alpha * p[a];
+            r[a] -= alpha * q[a];
+        }
+    }
+    let s: &State = st;
+    let [rz, rr] = tree_dot(pr, s, |i| {
+        let r = s.dfsph_cg[4 * i + R];
+        [dot(r, precondition(&s.dfsph_cg, i)), dot(r, r)]
+    });
+    let tolerance = pr.solve.dfsph_viscosity_tolerance;
+    let sv = &mut st.solvers[SLOT];
+    let [rz_old, rr0, _, _] = sv.scalars;
+    let beta = if rz_old > 0.0 { rz / rz_old } else { 0.0 };
+    sv.scalars[0] = rz;
+    sv.scalars[3] = beta;
+    let residual = if rr0 > 0.0 { (rr / rr0).sqrt() } else { 0.0 };
+    sv.finish(
+        residual,
+        residual <= tolerance,
+        pr.solve.dfsph_viscosity_max_iterations,
+    );
+    if converged(st) {
+        return;
+    }
+    for i in fluid(pr, st) {
+        let z = precondition(&st.dfsph_cg, i);
+        let p = &mut st.dfsph_cg[4 * i + P];
+        for a in 0..3 {
+            p[a] = z[a] + beta * p[a];
+        }
+    }
+}

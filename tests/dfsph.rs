@@ -95,8 +95,8 @@ fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
 
 /// scenarios/spray/j22_fluent_case_2d (J22's Fluent comparison, 2D coarse):
 /// impact, mean vertical velocity through zero and stop within 15% of J22's
-/// 0.5, 1.0 and 2.0 µs (the check's tolerance, issue 30's); measured 3.6%
-/// (0.501, 0.964, 1.95 µs). The splat spreads (a cylinder: 3.55 D0).
+/// 0.5, 1.0 and 2.0 µs (the check's tolerance, issue 30's); measured
+/// (0.501, 0.982, 1.90 µs: 1.8%). The splat spreads (a cylinder: 3.76 D0).
 #[test]
 fn spray_droplet_impact_matches_j22_timings() {
     let out = common::spatter(&[

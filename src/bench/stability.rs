@@ -304,7 +304,32 @@ fn extremes(quick: bool) -> Result<Vec<Case>, SpatterError> {
         let sets = with(coarse("0.01"), format!("jitter={j}"));
         cases.push(extreme(dam, "jitter / dx", j, sets, steps));
     }
+    // J22's droplet on DFSPH (2D) hitting the cold wall at 1 to 200 m/s.
+    let speeds: &[f64] = if quick {
+        &[200.0]
+    } else {
+        &[1.0, 10.0, 50.0, 200.0]
+    };
+    for &v in speeds {
+        let (label, text) = impact_scene(v);
+        cases.push(extreme((label, &text), "impact speed (m/s)", v, Vec::new(), steps));
+    }
     Ok(cases)
+}
+
+/// scenarios/spray/j22_fluent_case_2d with the droplet 2 µm above the wall at
+/// `speed`, run to 5 D0 / speed (the spread and the first rebound).
+fn impact_scene(speed: f64) -> (&'static str, String) {
+    let (label, text) = scene_file!("spray/j22_fluent_case_2d");
+    let swap = |t: &str, from: &str, to: &str| {
+        assert!(t.contains(from), "{label} no longer holds `{from}`");
+        t.replace(from, to)
+    };
+    let text = swap(text, "velocity = [0.0, -200.0]", &format!("velocity = [0.0, {:e}]", -speed));
+    let text = swap(&text, "center = [0.0, 1.31e-4]", "center = [0.0, 3.3e-5]");
+    let text = swap(&text, "end_time = 2.0e-6", &format!("end_time = {:e}", 5.0 * 62.0e-6 / speed));
+    let text = swap(&text, "output_interval = 5.0e-8", &format!("output_interval = {:e}", 0.25 * 62.0e-6 / speed));
+    (label, text)
 }
 
 fn dt_limit((label, text): (&str, &str), sets: &[String]) -> Result<f64, SpatterError> {

@@ -156,14 +156,60 @@ fn dfsph_viscosity_wall(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
         u.z + (u.z * sw - sv.z) / den, 0.0);
 }
 
+// J22 (15)-(16) as printed, on the right side: m_i dt a_i with a_i =
+// -gamma_f sum_{same phase} (m_bar / rho_bar) x_ij W_ij - gamma_b sum_b
+// (m_bar / rho_bar) x_ib W_ib, a wall's mass rho0_i V_b and density rho0_i.
+fn cohesion_impulse(i: u32) -> vec3<f32> {
+    let m_i = mass[i];
+    let rho_i = rho[i];
+    let ph_i = phase[i];
+    let rho0_i = P.phases[ph_i].rho0;
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var sf = vec3<f32>(0.0);
+    var sb = vec3<f32>(0.0);
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 < P.kernel.support2 && r2 > 0.0) {
+            let w = kernel_w(sqrt(r2));
+            if (is_wall(phase[j])) {
+                let m_b = rho0_i * dfsph[j].x;
+                let f = (m_i + m_b) / (rho_i + rho0_i) * w;
+                sb.x = sb.x + f * d.x;
+                sb.y = sb.y + f * d.y;
+                sb.z = sb.z + f * d.z;
+            } else if (phase[j] == ph_i) {
+                let f = (m_i + mass[j]) / (rho_i + rho[j]) * w;
+                sf.x = sf.x + f * d.x;
+                sf.y = sf.y + f * d.y;
+                sf.z = sf.z + f * d.z;
+            }
+        }
+    }
+    let gf = P.solve.dfsph_cohesion;
+    let gb = P.solve.dfsph_adhesion;
+    let mdt = m_i * sim.dt;
+    return vec3<f32>(-(gf * sf.x + gb * sb.x) * mdt, -(gf * sf.y + gb * sb.y) * mdt,
+        -(gf * sf.z + gb * sb.z) * mdt);
+}
+
 // Begin at x0 = v*: r = -sum (pair terms at v*), diag(A), p = z.
 @compute @workgroup_size(64)
 fn dfsph_viscosity_begin(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = thread_index(gid, nwg);
     if (!is_fluid_slot(i)) { return; }
     let acc = cg_sweep(i, 0u);
-    dfsph_cg[4u * i + CG_R] = vec4<f32>(-acc.x, -acc.y, -acc.z, 0.0);
-    dfsph_cg[4u * i + CG_DIAG] = vec4<f32>(cg_diag, 0.0);
+    let diag = cg_diag;
+    if (P.solve.dfsph_cohesion > 0.0 || P.solve.dfsph_adhesion > 0.0) {
+        let c = cohesion_impulse(i);
+        dfsph_cg[4u * i + CG_R] = vec4<f32>(c.x - acc.x, c.y - acc.y, c.z - acc.z, 0.0);
+    } else {
+        dfsph_cg[4u * i + CG_R] = vec4<f32>(-acc.x, -acc.y, -acc.z, 0.0);
+    }
+    cg_diag = diag;
+    dfsph_cg[4u * i + CG_DIAG] = vec4<f32>(diag, 0.0);
     dfsph_cg[4u * i + CG_P] = precondition(i);
 }
 

@@ -408,6 +408,10 @@ gpu_struct! {
         /// The implicit viscosity's form: 0 F22 (23) (Morris), 1 Weiler et
         /// al. (2018) / R18 (3.18) (`viscosity_form = "marrone"`).
         pub dfsph_viscosity_form: u32,
+        /// J22 (15) γ^f and (16) γ^b (1/s², per unit mass), on the CG's
+        /// right side; 0: off.
+        pub dfsph_cohesion: f32,
+        pub dfsph_adhesion: f32,
     }
 }
 
@@ -647,6 +651,8 @@ impl Params {
             dfsph_viscosity_eps: (0.01 * m.h * m.h) as f32,
             dfsph_viscosity_form: (m.viscosity_form == crate::scene::ViscosityForm::Marrone)
                 as u32,
+            dfsph_cohesion: m.dfsph.cohesion as f32,
+            dfsph_adhesion: m.dfsph.adhesion as f32,
         };
         if m.delta.is_some() {
             p.sizes.flags |= FLAG_CONTINUITY;

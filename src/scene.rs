@@ -459,6 +459,11 @@ pub struct DfsphDef {
     /// J22 (14)'s XSPH factor α (default 0: off; J22 uses 0.3), solved with
     /// the viscosity (needs `viscosity = "implicit"`).
     pub xsph: f64,
+    /// J22 (15)'s cohesion γ^f and (16)'s adhesion γ^b, read per unit mass
+    /// in 1/s² (J22 prints N/m and 200, which is nothing in SI units: see
+    /// docs/physics.md); default 0, on the implicit solve's right side.
+    pub cohesion: f64,
+    pub adhesion: f64,
 }
 
 impl Default for DfsphDef {
@@ -471,6 +476,8 @@ impl Default for DfsphDef {
             viscosity_tolerance: 1.0e-3,
             viscosity_max_iterations: 100,
             xsph: 0.0,
+            cohesion: 0.0,
+            adhesion: 0.0,
         }
     }
 }

@@ -843,9 +843,10 @@ fn powder_bed_of_1000_rigid_grains_200_steps() {
 const DFSPH: &str = "simulation.formulation=\"dfsph\"";
 
 /// Issue 30: a DFSPH droplet with heat hits a cold free-slip wall (J22's
-/// Fluent case, 2D at Δx = 4 µm): the implicit viscosity with XSPH, the
-/// conduction into the Dirichlet wall and the mushy-zone sink as the melt
-/// freezes, 150 steps (the impact at about 100).
+/// Fluent case, 2D at Δx = 4 µm): the implicit viscosity with XSPH, J22's
+/// cohesion and adhesion, the free-surface tension, the conduction into the
+/// Dirichlet wall and the mushy-zone sink as the melt freezes, 150 steps (the
+/// impact at about 100).
 #[test]
 fn dfsph_spray_droplet_150_steps() {
     let path = format!(
@@ -856,7 +857,8 @@ fn dfsph_spray_droplet_150_steps() {
         &path,
         &[
             "dx=4e-6",
-            "simulation.dfsph={ xsph = 0.3, max_iterations = 20, viscosity_max_iterations = 20 }",
+            "simulation.dfsph={ xsph = 0.3, max_iterations = 20, viscosity_max_iterations = 20, \
+             cohesion = 2e14, adhesion = 1e14 }",
         ],
         150,
     );

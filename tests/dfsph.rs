@@ -158,6 +158,11 @@ fn dfsph_keys_are_checked() {
     );
     for (set, key) in [
         ("simulation.dfsph.xsph=1.5", "simulation.dfsph.xsph"),
+        ("simulation.dfsph.cohesion=-1.0", "simulation.dfsph.cohesion"),
+        (
+            "simulation.dfsph={ viscosity = \"explicit\", adhesion = 1e14 }",
+            "simulation.dfsph.adhesion",
+        ),
         (
             "simulation.dfsph.viscosity_max_iterations=0",
             "simulation.dfsph.viscosity_max_iterations",

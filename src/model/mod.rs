@@ -1006,6 +1006,20 @@ fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, Inpu
             format!("must lie in [0, 1] (J22: 0.1 to 0.3), got {}", d.xsph),
         ));
     }
+    for (key, v) in [
+        ("simulation.dfsph.cohesion", d.cohesion),
+        ("simulation.dfsph.adhesion", d.adhesion),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(cx.err(key, format!("must be finite and >= 0 (1/s^2), got {v}")));
+        }
+        if v > 0.0 && d.viscosity == crate::scene::DfsphViscosity::Explicit {
+            return Err(cx.err(
+                key,
+                "is solved with the implicit viscosity: set viscosity = \"implicit\"",
+            ));
+        }
+    }
     if d.xsph > 0.0 && d.viscosity == crate::scene::DfsphViscosity::Explicit {
         return Err(cx.err(
             "simulation.dfsph.xsph",

@@ -34,7 +34,12 @@
 //!   pressure error swung between 20% and 150% (0.5-1.8% with the explicit
 //!   viscosity).
 //! - Scalars in the solver's slot: r·z, r0·r0, α, β.
-//! - Left out: J22's cohesion (15) and adhesion (16) terms.
+//! - J22's cohesion (15) and adhesion (16) as printed: on the right side,
+//!   with this step's positions (PAPERS-EXTRACT flags whether J22 predicts
+//!   them; the text says "implicit", the equation depends on x^t only).
+//!   γ is read per unit mass, in 1/s² (J22 prints N/m): J22's γ = 200 then
+//!   gives about 2e-5 m/s² at Δx = 0.8 µm, nothing against a 200 m/s impact,
+//!   so J22's value is not the scene's (issue 30's note).
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use super::reduce::tree_total;
@@ -121,6 +126,40 @@ fn sweep(
     (acc, dg)
 }
 
+/// J22 (15)–(16) as printed, on the right side (positions of this step):
+/// m_i Δt a_i with a_i = −γ^f Σ_{j, same phase} (m̄_ij/ρ̄_ij) x_ij W_ij
+/// − γ^b Σ_b (m̄_ib/ρ̄_ib) x_ib W_ib, a wall's mass ρ0_i V_b and density ρ0_i.
+fn cohesion_impulse(pr: &Params, st: &State, grid: &CellTable, i: usize) -> [f32; 3] {
+    let (m_i, rho_i, ph_i) = (st.mass[i], st.rho[i], st.phase[i]);
+    let rho0_i = pr.phase(ph_i).rho0;
+    let (mut sf, mut sb) = ([0.0f32; 3], [0.0f32; 3]);
+    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
+        if r2 <= 0.0 {
+            return;
+        }
+        let w = kernel::w(pr, r2.sqrt());
+        if pr.is_wall(st.phase[j]) {
+            let m_b = rho0_i * st.dfsph[j][0];
+            let f = (m_i + m_b) / (rho_i + rho0_i) * w;
+            for a in 0..3 {
+                sb[a] += f * d[a];
+            }
+        } else if st.phase[j] == ph_i {
+            let f = (m_i + st.mass[j]) / (rho_i + st.rho[j]) * w;
+            for a in 0..3 {
+                sf[a] += f * d[a];
+            }
+        }
+    });
+    let (gf, gb) = (pr.solve.dfsph_cohesion, pr.solve.dfsph_adhesion);
+    let mdt = m_i * st.sim.dt;
+    [
+        -(gf * sf[0] + gb * sb[0]) * mdt,
+        -(gf * sf[1] + gb * sb[1]) * mdt,
+        -(gf * sf[2] + gb * sb[2]) * mdt,
+    ]
+}
+
 fn fluid(pr: &Params, st: &State) -> Vec<usize> {
     (0..st.active())
         .filter(|&i| !pr.is_wall(st.phase[i]))
@@ -198,18 +237,28 @@ pub fn wall_velocities(pr: &Params, st: &mut State, grid: &CellTable) {
 /// solver reset with r·z and r0·r0, converged at once when r·z = 0.
 pub fn begin(pr: &Params, st: &mut State, grid: &CellTable) {
     let s: &State = st;
-    let rows: Vec<(usize, [f32; 3], [f32; 3])> = fluid(pr, s)
+    let cohesive = pr.solve.dfsph_cohesion > 0.0 || pr.solve.dfsph_adhesion > 0.0;
+    let rows: Vec<(usize, [f32; 3], [f32; 3], [f32; 3])> = fluid(pr, s)
         .into_par_iter()
         .map(|i| {
             let (acc, dg) = sweep(pr, s, grid, i, |j| xyz(s.vel[j]), |j| {
                 xyz(s.dfsph_cg[4 * j + R])
             });
-            (i, acc, dg)
+            let c = if cohesive {
+                cohesion_impulse(pr, s, grid, i)
+            } else {
+                [0.0; 3]
+            };
+            (i, acc, dg, c)
         })
         .collect();
-    for (i, acc, dg) in rows {
+    for (i, acc, dg, c) in rows {
         // Negated, not 0 − acc: lavapipe folds 0 − x into −x (−0 at x = 0).
-        st.dfsph_cg[4 * i + R] = [-acc[0], -acc[1], -acc[2], 0.0];
+        st.dfsph_cg[4 * i + R] = if cohesive {
+            [c[0] - acc[0], c[1] - acc[1], c[2] - acc[2], 0.0]
+        } else {
+            [-acc[0], -acc[1], -acc[2], 0.0]
+        };
         st.dfsph_cg[4 * i + DIAG] = [dg[0], dg[1], dg[2], 0.0];
         st.dfsph_cg[4 * i + P] = precondition(&st.dfsph_cg, i);
     }

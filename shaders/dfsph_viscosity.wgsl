@@ -1,8 +1,9 @@
 // uses: params consts kernel grid phase reduce
 // reads: pos mass phase rho dfsph
 // writes: vel dfsph_cg solvers partials
-// DFSPH's implicit velocity system, J22 (17) without cohesion and adhesion:
-// Weiler et al. (2018)'s viscosity and XSPH solved for v^{t+1} by matrix-free
+// DFSPH's implicit velocity system, J22 (17): the viscosity (F22 (23)'s form,
+// or Weiler et al. (2018)'s with viscosity_form = "marrone"), XSPH and the
+// cohesion and adhesion terms solved for v^{t+1} by matrix-free
 // Jacobi-preconditioned conjugate gradients, the system multiplied by m_i so
 // that it is symmetric. Twin of src/backend/cpu/dfsph_viscosity.rs (equations
 // and choices there). dfsph_cg[4 i + k]: k = 0 residual r, 1 direction p,

@@ -1,15 +1,21 @@
 //! Twin of shaders/dfsph_viscosity.wgsl: DFSPH's implicit velocity system,
-//! J22 (17) without its cohesion and adhesion terms: Weiler et al. (2018)'s
-//! viscosity (J22 (4)) and XSPH (J22 (14)) solved together for v^{t+1} by
-//! matrix-free conjugate gradients (Jacobi preconditioned), after v* = v +
-//! Δt a (the explicit forces) and before the constant-density solve.
+//! J22 (17): the viscosity, XSPH (J22 (14)) and the cohesion and adhesion
+//! terms (J22 (15)–(16)) solved together for v^{t+1} by matrix-free
+//! conjugate gradients (Jacobi preconditioned), after v* = v + Δt a (the
+//! explicit forces) and before the constant-density solve.
 //!
 //! - The system, multiplied by m_i so that the matrix is symmetric:
-//!   m_i v_i + Σ_j [k_ij x_ij (x_ij·(v_i − v_j)) + s_ij (v_i − v_j)] = m_i v*_i,
-//!   k_ij = −Δt 2(d+2) μ_ij V_i V_j (∂W/∂r / r) / (r² + 0.01 h²) ≥ 0 and
-//!   s_ij = α m_i m_j W_ij / ρ̄_ij ≥ 0 (ρ̄ the mean, α J22's XSPH factor).
-//!   Its pair blocks are positive semi-definite and the masses make it
-//!   positive definite, so CG converges.
+//!   m_i v_i + Σ_j [K_ij (v_i − v_j) + s_ij (v_i − v_j)] = m_i v*_i + c_i,
+//!   with the viscous pair block K_ij either F22 (23)'s isotropic
+//!   −Δt μ_ij (V_i² + V_j²) (∂W/∂r / r) I (the default) or Weiler et al.
+//!   (2018)'s projected −Δt 2(d+2) μ_ij V_i V_j (∂W/∂r / r) x_ij x_ijᵀ
+//!   / (r² + 0.01 h²) (J22 (4) and (17); `viscosity_form = "marrone"`),
+//!   s_ij = α m_i m_j W_ij / ρ̄_ij (ρ̄ the mean, α J22's XSPH factor) and
+//!   c_i the cohesion and adhesion impulse. The pair blocks are positive
+//!   semi-definite and the masses make the matrix positive definite, so CG
+//!   converges. Weiler's form is 0.83 of the Laplacian at h = Δx with the
+//!   quintic (terms/marrone_viscosity.rs): Poiseuille 18% off, against 0.17%
+//!   with F22's.
 //! - μ_ij = 2 μ_i μ_j / (μ_i + μ_j) (the explicit viscosity's mean); J22 has
 //!   one fluid. XSPH takes m_j / ρ̄_ij where J22 has m̄_ij / ρ̄_ij (the same for
 //!   one material): with it the matrix stays symmetric and the pair impulses

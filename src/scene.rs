@@ -876,6 +876,8 @@ pub struct CheckDef {
     /// R18 track: the depth (m) a 2D slice stands for, so that R18's watts are
     /// the power per metre times it. Its `surface` is the plate's initial top.
     pub r18_slice_depth: Option<f64>,
+    /// remelt: the reference remelt depth (m; F22 §4.3).
+    pub depth: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -963,6 +965,9 @@ pub enum CheckKind {
     /// J22 §4.1: a droplet's impact, mean vertical velocity through zero and
     /// stop against J22's Fluent comparison; splat diameter and height.
     Splat,
+    /// F22 §4.3: the deepest substrate remelt under a molten drop against a
+    /// reference depth (`depth`).
+    Remelt,
 }
 
 impl CheckKind {
@@ -999,6 +1004,7 @@ impl CheckKind {
             CheckKind::PressureNoise => "pressure_noise",
             CheckKind::R18Track => "r18_track",
             CheckKind::Splat => "splat",
+            CheckKind::Remelt => "remelt",
         }
     }
 }

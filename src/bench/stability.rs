@@ -111,6 +111,8 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
     (scene_file!("spray/j22_fluent_case_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_3d"), &[]),
+    (scene_file!("mjt/drop_on_hot_substrate_3d"), &[]),
+    (scene_file!("mjt/drop_on_cold_substrate_3d"), &[]),
 ];
 
 /// The long runs `--quick` keeps (one per kind of physics).
@@ -710,10 +712,10 @@ mod every_scene {
     use super::LONG_RUNS;
 
     /// "Long runs of every validation and process scene": each scene file under
-    /// scenarios/validation, scenarios/pbf and scenarios/spray has a LONG_RUNS row.
+    /// scenarios/validation, pbf, spray and mjt has a LONG_RUNS row.
     #[test]
     fn every_validation_and_process_scene_has_a_long_run() {
-        for dir in ["validation", "pbf", "spray"] {
+        for dir in ["validation", "pbf", "spray", "mjt"] {
             let path = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
             for entry in std::fs::read_dir(&path).unwrap() {
                 let name = entry.unwrap().file_name().into_string().unwrap();

@@ -10,7 +10,8 @@
 //! bodies: restitution, free rotation, flotation, a bed at rest, a melting grain),
 //! expansion.rs (δ-SPH thermal expansion: R18 Tests 1, 2 and 3), noise.rs (pressure
 //! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track), splat.rs
-//! (J22's droplet impact timings and splat size).
+//! (J22's droplet impact timings and splat size), remelt.rs (F22 §4.3: a
+//! drop's remelt of its substrate).
 
 mod bodies;
 mod compression;
@@ -19,6 +20,7 @@ mod expansion;
 mod flow;
 mod heat;
 mod noise;
+mod remelt;
 mod solidification;
 mod splat;
 mod tension;
@@ -170,6 +172,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
         CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
         CheckKind::Splat => Box::new(splat::Splat::default()),
+        CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

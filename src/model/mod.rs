@@ -601,6 +601,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Thermocapillary {
             thermocapillary_layout(&cx, scene, dim, &phases, surface_tension.as_ref(), c)?;
         }
+        if c.kind == crate::scene::CheckKind::Remelt {
+            let d = c.depth.unwrap_or(f64::NAN);
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(cx.err("check.depth", "\"remelt\" needs the reference depth (m, >= 0)"));
+            }
+            if !phases.iter().any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some()) {
+                return Err(cx.err("check.kind", "\"remelt\" needs a solid phase that melts"));
+            }
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;

@@ -1,10 +1,12 @@
-// reads: partials
+// writes: partials
 // A fixed two-level tree sum of one vec2 per thread: each workgroup of DWG
 // threads sums its values pairwise (s = 128, 64, ..., 1), thread 0 stores the
 // group's sum in partials; then one workgroup adds the partials, thread t
 // the ones at t, t + DWG, ... in order, and sums those pairwise. The CPU twin
 // (backend::cpu::reduce::tree_total) adds the same pairs, so a solver's
-// residual and dot products bit-match. A pass that uses it writes partials.
+// residual and dot products bit-match. A pass that uses it names partials
+// on its own `// writes:` line too (a library's writes bind only in the
+// arithmetic probe, which composes every library).
 
 const DWG: u32 = 256u;
 var<workgroup> dred: array<vec2<f32>, 256>;

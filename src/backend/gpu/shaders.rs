@@ -191,13 +191,14 @@ pub fn expand_reorder(src: &str) -> Result<String, String> {
 pub fn all_libraries() -> String {
     let names: Vec<&str> = LIBS.iter().map(|(n, _)| *n).collect();
     let mut out = String::new();
-    let mut reads = Vec::new();
+    let (mut reads, mut writes) = (Vec::new(), Vec::new());
     for k in resolve(&names).expect("LIBS resolves") {
         out.push_str(LIBS[k].1);
         out.push('\n');
         reads.extend(header(LIBS[k].1, "reads"));
+        writes.extend(header(LIBS[k].1, "writes"));
     }
-    let bindings = pass_bindings_of(&reads, &[]).expect("library reads are buffers");
+    let bindings = pass_bindings_of(&reads, &writes).expect("library buffers are buffers");
     out.push_str(&declarations(&bindings));
     out
 }

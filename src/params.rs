@@ -649,8 +649,7 @@ impl Params {
             },
             dfsph_xsph: m.dfsph.xsph as f32,
             dfsph_viscosity_eps: (0.01 * m.h * m.h) as f32,
-            dfsph_viscosity_form: (m.viscosity_form == crate::scene::ViscosityForm::Marrone)
-                as u32,
+            dfsph_viscosity_form: (m.viscosity_form == crate::scene::ViscosityForm::Marrone) as u32,
             dfsph_cohesion: m.dfsph.cohesion as f32,
             dfsph_adhesion: m.dfsph.adhesion as f32,
         };

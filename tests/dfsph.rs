@@ -86,10 +86,21 @@ fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
         .find(|l| l.starts_with("check poiseuille"))
         .expect(&o);
     assert!(line.ends_with("PASS"), "{line}");
-    let value: f64 = line.split(" = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    let value: f64 = line
+        .split(" = ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(value < 0.005, "{line}: measured 0.17% when this landed");
     let o = run(&["simulation.viscosity_form=\"marrone\""], 1);
-    let line = o.lines().find(|l| l.starts_with("check poiseuille")).expect(&o);
+    let line = o
+        .lines()
+        .find(|l| l.starts_with("check poiseuille"))
+        .expect(&o);
     println!("Weiler / Marrone form: {line}");
 }
 
@@ -158,7 +169,10 @@ fn dfsph_keys_are_checked() {
     );
     for (set, key) in [
         ("simulation.dfsph.xsph=1.5", "simulation.dfsph.xsph"),
-        ("simulation.dfsph.cohesion=-1.0", "simulation.dfsph.cohesion"),
+        (
+            "simulation.dfsph.cohesion=-1.0",
+            "simulation.dfsph.cohesion",
+        ),
         (
             "simulation.dfsph={ viscosity = \"explicit\", adhesion = 1e14 }",
             "simulation.dfsph.adhesion",

@@ -6,7 +6,10 @@ mod common;
 
 #[test]
 fn material_jetting_scenes_validate_and_need_their_reference_depth() {
-    for name in ["mjt/drop_on_hot_substrate_3d", "mjt/drop_on_cold_substrate_3d"] {
+    for name in [
+        "mjt/drop_on_hot_substrate_3d",
+        "mjt/drop_on_cold_substrate_3d",
+    ] {
         let scene = common::scene_at(name);
         let out = common::spatter(&["validate", &scene]);
         let (o, e) = common::text(&out);

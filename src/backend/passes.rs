@@ -159,8 +159,7 @@ impl Features {
             continuity: params.flag(FLAG_CONTINUITY),
             solidification: params.flag(FLAG_SOLIDIFICATION),
             dfsph: params.solve.formulation == crate::scene::Formulation::Dfsph.code(),
-            dfsph_viscosity: params.solve.formulation
-                == crate::scene::Formulation::Dfsph.code()
+            dfsph_viscosity: params.solve.formulation == crate::scene::Formulation::Dfsph.code()
                 && params.solve.dfsph_viscosity_max_iterations > 0,
         }
     }

@@ -182,7 +182,7 @@ const DFSPH_STEP: [Stage; 15] = [
     Stage::DfsphViscosityWall,
     Stage::DfsphPredict,
     Stage::DfsphViscosityBegin, // a repeat (conjugate gradients)
-    Stage::DfsphDensityBegin, // a repeat (DFSPH_DENSITY)
+    Stage::DfsphDensityBegin,   // a repeat (DFSPH_DENSITY)
     Stage::DfsphDrift,
     Stage::Timestep,
 ];

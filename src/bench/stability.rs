@@ -314,7 +314,13 @@ fn extremes(quick: bool) -> Result<Vec<Case>, SpatterError> {
     };
     for &v in speeds {
         let (label, text) = impact_scene(v);
-        cases.push(extreme((label, &text), "impact speed (m/s)", v, Vec::new(), steps));
+        cases.push(extreme(
+            (label, &text),
+            "impact speed (m/s)",
+            v,
+            Vec::new(),
+            steps,
+        ));
     }
     Ok(cases)
 }
@@ -327,10 +333,22 @@ fn impact_scene(speed: f64) -> (&'static str, String) {
         assert!(t.contains(from), "{label} no longer holds `{from}`");
         t.replace(from, to)
     };
-    let text = swap(text, "velocity = [0.0, -200.0]", &format!("velocity = [0.0, {:e}]", -speed));
+    let text = swap(
+        text,
+        "velocity = [0.0, -200.0]",
+        &format!("velocity = [0.0, {:e}]", -speed),
+    );
     let text = swap(&text, "center = [0.0, 1.31e-4]", "center = [0.0, 3.3e-5]");
-    let text = swap(&text, "end_time = 2.0e-6", &format!("end_time = {:e}", 5.0 * 62.0e-6 / speed));
-    let text = swap(&text, "output_interval = 5.0e-8", &format!("output_interval = {:e}", 0.25 * 62.0e-6 / speed));
+    let text = swap(
+        &text,
+        "end_time = 2.0e-6",
+        &format!("end_time = {:e}", 5.0 * 62.0e-6 / speed),
+    );
+    let text = swap(
+        &text,
+        "output_interval = 5.0e-8",
+        &format!("output_interval = {:e}", 0.25 * 62.0e-6 / speed),
+    );
     (label, text)
 }
 

@@ -67,11 +67,11 @@ impl Check for Remelt {
     }
 
     fn verdict(&mut self, m: &Model, _st: &State) -> Verdict {
-        let (t_max, d_max) = self
-            .samples
-            .iter()
-            .copied()
-            .fold((f64::NAN, 0.0), |best, s| if s.1 > best.1 { s } else { best });
+        let (t_max, d_max) =
+            self.samples.iter().copied().fold(
+                (f64::NAN, 0.0),
+                |best, s| if s.1 > best.1 { s } else { best },
+            );
         let mut details = vec!["  t (s), remelt depth (m):".to_string()];
         for (t, d) in &self.samples {
             details.push(format!("  {t:.4e} {d:.4e}"));

@@ -85,13 +85,22 @@ impl Splat {
                 .sqrt()
         };
         let diameter = if m.dim == 2 {
-            let lo = splat.iter().map(|&k| xs[k][0]).fold(f64::INFINITY, f64::min);
-            let hi = splat.iter().map(|&k| xs[k][0]).fold(f64::NEG_INFINITY, f64::max);
+            let lo = splat
+                .iter()
+                .map(|&k| xs[k][0])
+                .fold(f64::INFINITY, f64::min);
+            let hi = splat
+                .iter()
+                .map(|&k| xs[k][0])
+                .fold(f64::NEG_INFINITY, f64::max);
             hi - lo + m.dx
         } else {
             2.0 * splat.iter().map(|&k| across(k)).fold(0.0, f64::max) + m.dx
         };
-        let top = splat.iter().map(|&k| xs[k][axis]).fold(f64::NEG_INFINITY, f64::max);
+        let top = splat
+            .iter()
+            .map(|&k| xs[k][axis])
+            .fold(f64::NEG_INFINITY, f64::max);
         let splat_mass: f64 = splat.iter().map(|&k| ms[k]).sum();
         let splat_speed = splat
             .iter()
@@ -167,12 +176,18 @@ impl Check for Splat {
             show(stopped)
         ));
         let rel = |t: Option<f64>, r: f64| t.map_or(f64::INFINITY, |t| (t - r).abs() / r);
-        let late = stopped.map_or(f64::INFINITY, |t| ((t - J22_STOPPED) / J22_STOPPED).max(0.0));
+        let late = stopped.map_or(f64::INFINITY, |t| {
+            ((t - J22_STOPPED) / J22_STOPPED).max(0.0)
+        });
         let value = rel(impact, J22_IMPACT)
             .max(rel(zero, J22_ZERO_CROSSING))
             .max(late);
         let mut figures = vec![("spread_factor".to_string(), xi)];
-        for (name, t) in [("impact", impact), ("zero_crossing", zero), ("stopped", stopped)] {
+        for (name, t) in [
+            ("impact", impact),
+            ("zero_crossing", zero),
+            ("stopped", stopped),
+        ] {
             figures.push((name.to_string(), t.unwrap_or(f64::NAN)));
         }
         Verdict {

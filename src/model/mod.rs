@@ -470,10 +470,10 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .filter(|_| !implicit_viscosity)
         .map(|p| p.viscosity / p.rho0)
         .fold(
-        interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
-            + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
-        f64::max,
-    );
+            interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
+                + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
+            f64::max,
+        );
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
     let powder = powder_bed(&cx, scene, dim, &phases)?;
@@ -604,9 +604,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Remelt {
             let d = c.depth.unwrap_or(f64::NAN);
             if !(d.is_finite() && d >= 0.0) {
-                return Err(cx.err("check.depth", "\"remelt\" needs the reference depth (m, >= 0)"));
+                return Err(cx.err(
+                    "check.depth",
+                    "\"remelt\" needs the reference depth (m, >= 0)",
+                ));
             }
-            if !phases.iter().any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some()) {
+            if !phases
+                .iter()
+                .any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some())
+            {
                 return Err(cx.err("check.kind", "\"remelt\" needs a solid phase that melts"));
             }
         }
@@ -1008,7 +1014,10 @@ fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, Inpu
             ),
         ));
     }
-    cx.positive("simulation.dfsph.viscosity_tolerance", d.viscosity_tolerance)?;
+    cx.positive(
+        "simulation.dfsph.viscosity_tolerance",
+        d.viscosity_tolerance,
+    )?;
     if !(d.xsph.is_finite() && (0.0..=1.0).contains(&d.xsph)) {
         return Err(cx.err(
             "simulation.dfsph.xsph",

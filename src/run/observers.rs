@@ -72,10 +72,7 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     }
     let solves = crate::diagnostics::solver_names(m);
     if !solves.is_empty() && !opts.quiet {
-        list.push(Box::new(SolverCaps {
-            last: None,
-            solves,
-        }));
+        list.push(Box::new(SolverCaps { last: None, solves }));
     }
     if m.watchdog.enabled
         && m.dispersion_action() == crate::scene::DispersionAction::Warn

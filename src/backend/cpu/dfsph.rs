@@ -49,10 +49,10 @@
 //!   boundaries, moving walls and rigid bodies.
 
 use super::integrate::{stamp_if_left, wrap_periodic};
-use super::reduce::tree_total;
 use super::neighbors::{
     for_each_neighbor, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
 };
+use super::reduce::tree_total;
 use crate::backend::schedule::SolverSlot;
 use crate::kernel;
 use crate::params::Params;
@@ -364,7 +364,11 @@ pub fn predict(pr: &Params, st: &mut State, grid: &CellTable) {
         st.dfsph_warm[i][1] = dt * st.dfsph[i][3];
         let a = st.acc[i];
         let sink = pr.phase(st.phase[i]).mushy_damping;
-        let liquid = if sink > 0.0 { st.heat[i][H_LIQUID] } else { 1.0 };
+        let liquid = if sink > 0.0 {
+            st.heat[i][H_LIQUID]
+        } else {
+            1.0
+        };
         let v = &mut st.vel[i];
         for c in 0..3 {
             v[c] = v[c] + dt * a[c] - dt * b[c];

@@ -247,9 +247,14 @@ pub fn begin(pr: &Params, st: &mut State, grid: &CellTable) {
     let rows: Vec<(usize, [f32; 3], [f32; 3], [f32; 3])> = fluid(pr, s)
         .into_par_iter()
         .map(|i| {
-            let (acc, dg) = sweep(pr, s, grid, i, |j| xyz(s.vel[j]), |j| {
-                xyz(s.dfsph_cg[4 * j + R])
-            });
+            let (acc, dg) = sweep(
+                pr,
+                s,
+                grid,
+                i,
+                |j| xyz(s.vel[j]),
+                |j| xyz(s.dfsph_cg[4 * j + R]),
+            );
             let c = if cohesive {
                 cohesion_impulse(pr, s, grid, i)
             } else {
@@ -289,9 +294,7 @@ pub fn apply(pr: &Params, st: &mut State, grid: &CellTable) {
     let rows: Vec<(usize, [f32; 3])> = fluid(pr, s)
         .into_par_iter()
         .map(|i| {
-            let (acc, _) = sweep(pr, s, grid, i, |j| xyz(s.dfsph_cg[4 * j + P]), |_| {
-                [0.0; 3]
-            });
+            let (acc, _) = sweep(pr, s, grid, i, |j| xyz(s.dfsph_cg[4 * j + P]), |_| [0.0; 3]);
             (i, acc)
         })
         .collect();

@@ -7,7 +7,8 @@
 // Jacobi-preconditioned conjugate gradients, the system multiplied by m_i so
 // that it is symmetric. Twin of src/backend/cpu/dfsph_viscosity.rs (equations
 // and choices there). dfsph_cg[4 i + k]: k = 0 residual r, 1 direction p,
-// 2 A p, 3 diag(A).
+// 2 A p, 3 diag(A). pair_viscosity comes from shaders/terms/viscosity.wgsl
+// (backend::terms::BORROWED).
 
 const CG_R: u32 = 0u;
 const CG_P: u32 = 1u;
@@ -53,16 +54,6 @@ fn cg_pair(i: u32, j: u32, vol_i: f32, r2: f32) -> vec3<f32> {
         s = P.solve.dfsph_xsph * mass[i] * mass[j] * kernel_w(r) / ((rho_i + rho_j) * c_half());
     }
     return vec3<f32>(kp, ki, s);
-}
-
-// Twin of the CPU's pair_viscosity (terms/viscosity): the harmonic mean, 0
-// against a free-slip wall.
-fn pair_viscosity(eta_i: f32, eta_j: f32, slip: bool) -> f32 {
-    let eta_sum = eta_i + eta_j;
-    if (eta_sum > 0.0 && !slip) {
-        return c_two() * eta_i * eta_j / eta_sum;
-    }
-    return 0.0;
 }
 
 var<private> cg_diag: vec3<f32>;

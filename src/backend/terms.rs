@@ -178,9 +178,15 @@ pub fn reaction_terms() -> impl Iterator<Item = &'static PairTerm> {
 
 /// Whether `pass`'s WGSL carries term `t`: its own, a reaction term in the
 /// bodies pass, or a term one of those needs.
+/// Passes outside a term's sweep that call its WGSL functions (DFSPH's
+/// implicit viscosity takes the viscous term's pair mean).
+const BORROWED: [(&str, &str); 1] = [("dfsph_viscosity", "viscosity")];
+
 fn carried(pass: &str, t: &PairTerm) -> bool {
     let direct = |u: &PairTerm| {
-        u.pass == pass || (pass == REACTION_PASS && reaction_terms().any(|r| r.name == u.name))
+        u.pass == pass
+            || (pass == REACTION_PASS && reaction_terms().any(|r| r.name == u.name))
+            || BORROWED.contains(&(pass, u.name))
     };
     direct(t)
         || PAIR_TERMS

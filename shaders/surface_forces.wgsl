@@ -6,7 +6,8 @@
 // liquid and the gas of P.tension (curvature kappa_i, Morris 2000 / F22 (25), to
 // surface[n + i][S_CURVATURE]), or in the free-surface form (R18 3.1.1-3.1.2) its raw
 // curvature (tension_curvature) then the smoothed curvature and force
-// (tension_smooth); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
+// (tension_smooth), or J22 (5)-(8)'s colour Laplacian in its place
+// (tension_colour, tension_laplacian); recoil, F22 (30). Twin of src/backend/cpu/surface_forces.rs
 // (equations and choices there).
 
 // F22 (21) f[T, T_m, T_m + dT_s]; 1 without a ramp.
@@ -264,4 +265,72 @@ fn recoil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     a.y = a.y - f * s.y;
     a.z = a.z - f * s.z;
     acc[i] = a;
+}
+
+// J22 (5), first dispatch of model = "muller": the colour c_i = sum_j (m_j / rho_j)
+// W_ij over the liquid's particles (j = i included), to surface[n + i][S_COLOUR].
+// Twin of tension_colour in src/backend/cpu/surface_forces.rs.
+@compute @workgroup_size(64)
+fn tension_colour(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let n = P.sizes.n_particles;
+    let liquid = P.tension.liquid;
+    if (phase[i] != liquid) { return; }
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var c = 0.0;
+    #for_each_neighbor(ci, zr, j) {
+        let r2 = len2(min_image(pi, pos[j]));
+        if (r2 < P.kernel.support2 && phase[j] == liquid) {
+            c = c + mass[j] / rho[j] * kernel_w(sqrt(r2));
+        }
+    }
+    surface[n + i][S_COLOUR] = c;
+}
+
+// J22 (6)-(8), second dispatch: the colour's gradient n_i and Laplacian, and the
+// force -sigma lap n / |n| per unit volume, divided by rho_i, where |n| passes
+// the interface's threshold 0.1 / h. Twin of tension_laplacian (equations there).
+@compute @workgroup_size(64)
+fn tension_laplacian(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= active_particles()) { return; }
+    let n = P.sizes.n_particles;
+    let liquid = P.tension.liquid;
+    if (phase[i] != liquid) { return; }
+    let c_i = surface[n + i][S_COLOUR];
+    let eps = P.kernel.h * c_tenth() * c_tenth();
+    let pi = pos[i];
+    let ci = cell_coord(pi);
+    let zr = z_range();
+    var g = vec3<f32>(0.0);
+    var lap = 0.0;
+    #for_each_neighbor(ci, zr, j) {
+        let d = min_image(pi, pos[j]);
+        let r2 = len2(d);
+        if (r2 >= P.kernel.support2 || r2 <= 0.0 || phase[j] != liquid) { continue; }
+        let r = sqrt(r2);
+        let v_j = mass[j] / rho[j];
+        let dc = surface[n + j][S_COLOUR] - c_i;
+        let dw = kernel_dw(r);
+        let f = v_j * dc * dw / r;
+        g.x = g.x + f * d.x;
+        g.y = g.y + f * d.y;
+        g.z = g.z + f * d.z;
+        lap = lap + v_j * dc * c_two() * abs(dw) / (r + eps);
+    }
+    let gl = sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    var kappa = 0.0;
+    if (gl > c_tenth() * P.kernel.inv_h) {
+        kappa = -(lap / gl);
+        let scale = P.tension.alpha0 * tension_ramp(tension_temperature(i)) * kappa / rho[i];
+        var a = acc[i];
+        a.x = a.x + scale * g.x;
+        a.y = a.y + scale * g.y;
+        a.z = a.z + scale * g.z;
+        acc[i] = a;
+    }
+    surface[n + i][S_CURVATURE] = kappa;
 }

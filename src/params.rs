@@ -54,6 +54,9 @@ pub const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768;
 pub const FLAG_SOLIDIFICATION: u32 = 65536;
 /// Divergence-free SPH: its warm-start store is sorted with the particles.
 pub const FLAG_DFSPH: u32 = 131072;
+/// Free-surface tension by J22 (5)-(8)'s colour Laplacian (`model = "muller"`):
+/// the `tension_colour` and `tension_laplacian` dispatches replace R18's CSF pair.
+pub const FLAG_COLOUR_TENSION: u32 = 262144;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -721,6 +724,9 @@ impl Params {
                 Some(g) => t.gas = g as u32,
                 None => {
                     p.sizes.flags |= FLAG_FREE_SURFACE_TENSION;
+                    if s.colour_laplacian {
+                        p.sizes.flags |= FLAG_COLOUR_TENSION;
+                    }
                     t.gas = NO_PHASE;
                     t.kappa_max = (1.0 / m.support) as f32;
                     if s.thin_layer_rows > 0 {

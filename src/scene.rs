@@ -272,6 +272,12 @@ pub struct SolidFluidViscosityDef {
 pub struct SurfaceTensionDef {
     /// The liquid phase.
     pub liquid: String,
+    /// How the force is computed: `"csf"` (default; F22 (24)-(26) with gas, R18's
+    /// free-surface CSF without) or `"muller"`, J22 (5)-(8) after Müller et al.
+    /// 2003: a colour field's Laplacian along its gradient, free-surface form only,
+    /// constant coefficient, no Marangoni stress.
+    #[serde(default)]
+    pub model: TensionModel,
     /// The gas phase around it (F22's form). Absent: the free-surface form, for
     /// scenes without gas particles.
     pub gas: Option<String>,
@@ -303,6 +309,17 @@ pub struct SurfaceTensionDef {
     /// many particles thick (R18: 2): their normal and curvature come from a
     /// support that holds one or two rows. Absent or 0: tension everywhere.
     pub thin_layer_rows: Option<u32>,
+}
+
+/// `surface_tension.model`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TensionModel {
+    /// Continuum surface force from the normals' divergence (F22, R18).
+    #[default]
+    Csf,
+    /// J22 (5)-(8): f = −σ ∇²c n/|n| of the colour c = Σ V_j W_ij (Müller 2003).
+    Muller,
 }
 
 /// `surface_tension.sahoo`: the surface-active solute's term of R18 (4.2)

@@ -151,6 +151,9 @@ pub const S_CURVATURE: usize = 1;
 pub const S_RAW_CURVATURE: usize = 2;
 /// Free-surface tension with `thin_layer_rows`: 1 on a thin layer's particle.
 pub const S_THIN: usize = 3;
+/// J22 (5)'s colour c_i (`model = "muller"`), in the raw curvature's slot: the two
+/// free-surface forms never run in one scene.
+pub const S_COLOUR: usize = 2;
 /// `solidification[id]` is (time, G, cooling rate, crossings);
 /// `solidification[n + id]` is (position xyz, gradient pending).
 pub const SOL_TIME: usize = 0;

@@ -304,6 +304,7 @@ const FLAG_MARRONE_VISCOSITY: u32 = 16384u;
 const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768u;
 const FLAG_SOLIDIFICATION: u32 = 65536u;
 const FLAG_DFSPH: u32 = 131072u;
+const FLAG_COLOUR_TENSION: u32 = 262144u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;
@@ -341,6 +342,7 @@ const S_SHEPARD: u32 = 0u;
 const S_CURVATURE: u32 = 1u;
 const S_RAW_CURVATURE: u32 = 2u;
 const S_THIN: u32 = 3u;
+const S_COLOUR: u32 = 2u;
 // solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
 // (position xyz, gradient pending): the last liquidus crossing on cooling.
 const SOL_TIME: u32 = 0u;

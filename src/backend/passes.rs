@@ -6,9 +6,9 @@
 use super::cpu::CpuBackend;
 use super::schedule::SolverSlot;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION, FLAG_GAS_INTERFACE, FLAG_HEAT,
-    FLAG_INTERFACE, FLAG_RECOIL, FLAG_SOLIDIFICATION, FLAG_SURFACE_TENSION, FLAG_WETTING,
-    HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT, LASER_SURFACE,
+    Params, FLAG_BODIES, FLAG_COLOUR_TENSION, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION,
+    FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL, FLAG_SOLIDIFICATION,
+    FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT, LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -117,6 +117,8 @@ pub struct Features {
     pub surface_tension: bool,
     /// Its free-surface form (R18): the curvature is smoothed in a second dispatch.
     pub free_surface_tension: bool,
+    /// Its colour-Laplacian model (J22 (5)–(8), `model = "muller"`) in place of CSF.
+    pub colour_tension: bool,
     /// F22 (27)–(29) wetting: the interface pass prescribes the normal near solids.
     pub wetting: bool,
     /// F22 (30) recoil pressure.
@@ -151,6 +153,7 @@ impl Features {
             laser_surface: params.laser.model == LASER_SURFACE,
             surface_tension: params.flag(FLAG_SURFACE_TENSION),
             free_surface_tension: params.flag(FLAG_FREE_SURFACE_TENSION),
+            colour_tension: params.flag(FLAG_COLOUR_TENSION),
             wetting: params.flag(FLAG_WETTING),
             recoil: params.flag(FLAG_RECOIL),
             bodies: params.flag(FLAG_BODIES),
@@ -512,14 +515,26 @@ pub const STAGES: [StageDef; 33] = [
             when(
                 "tension_curvature",
                 Work::Particles,
-                |f| f.free_surface_tension,
+                |f| f.free_surface_tension && !f.colour_tension,
                 |b| b.tension_curvature(),
             ),
             when(
                 "tension_smooth",
                 Work::Particles,
-                |f| f.free_surface_tension,
+                |f| f.free_surface_tension && !f.colour_tension,
                 |b| b.tension_smooth(),
+            ),
+            when(
+                "tension_colour",
+                Work::Particles,
+                |f| f.colour_tension,
+                |b| b.tension_colour(),
+            ),
+            when(
+                "tension_laplacian",
+                Work::Particles,
+                |f| f.colour_tension,
+                |b| b.tension_laplacian(),
             ),
             when("recoil", Work::Particles, |f| f.recoil, |b| b.recoil()),
         ],

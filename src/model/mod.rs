@@ -665,6 +665,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
              and 8.5e-3 of its momentum with it, none and 9.4e-7 without); set it false"
         ));
     }
+    if surface_tension.as_ref().is_some_and(|s| s.colour_laplacian) {
+        warnings.push(format!(
+            "{file}: key `surface_tension.model`: J22 (5)-(8) as printed holds no drop together \
+             at a free surface. On the Laplace disc (R = 20 dx) summation density (wcsph, dfsph) \
+             leaves the colour at 0.99 on the surface and no force (jump -99.997%); on \
+             delta_wcsph the outer row is pushed outward (-98.8%, 40 of 1264 particles blown \
+             off). It is here to reproduce J22; model = \"csf\" is the surface tension"
+        ));
+    }
     let wd = &scene.watchdog;
     cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
     cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;

@@ -27,6 +27,8 @@ pub struct SurfaceTension {
     /// R18 §4.4: no tension where the liquid under a surface particle is at most
     /// this many rows thick (0: off; free-surface form only).
     pub thin_layer_rows: u32,
+    /// J22 (5)-(8)'s colour-Laplacian force (`model = "muller"`) in place of CSF.
+    pub colour_laplacian: bool,
 }
 
 /// R's gas constant, J/(mol K).
@@ -227,7 +229,9 @@ pub(super) fn surface_tension(
         Some(def) => Some(contact_angles(cx, def, phases, gas.is_some())?),
     };
     let thin_layer_rows = thin_layer_rows(cx, d, gas.is_some(), support, dx)?;
+    let colour_laplacian = colour_laplacian(cx, d, gas.is_some())?;
     Ok(Some(SurfaceTension {
+        colour_laplacian,
         thin_layer_rows,
         contact_angle,
         liquid,
@@ -271,6 +275,40 @@ fn thin_layer_rows(
         ));
     }
     Ok(rows)
+}
+
+/// `surface_tension.model = "muller"`: J22's form is written for a liquid without
+/// gas particles and a constant σ; what it does not define is refused rather than
+/// dropped in silence.
+fn colour_laplacian(
+    cx: &Ctx,
+    d: &crate::scene::SurfaceTensionDef,
+    gas: bool,
+) -> Result<bool, InputError> {
+    if d.model != crate::scene::TensionModel::Muller {
+        return Ok(false);
+    }
+    let refuse =
+        |key: &str, why: &str| Err(cx.err(key, format!("model = \"muller\" (J22 (5)-(8)) {why}")));
+    if gas {
+        return refuse(
+            "surface_tension.gas",
+            "is the free-surface form: drop `gas` and the gas particles, or use model = \"csf\"",
+        );
+    }
+    if d.temperature_coefficient != 0.0 || d.sahoo.is_some() {
+        return refuse(
+            "surface_tension.temperature_coefficient",
+            "has a constant coefficient and no Marangoni stress: use model = \"csf\" for α(T)",
+        );
+    }
+    if d.thin_layer_rows.unwrap_or(0) > 0 {
+        return refuse(
+            "surface_tension.thin_layer_rows",
+            "has no thin-film rule (R18 §4.4 is the CSF form's)",
+        );
+    }
+    Ok(true)
 }
 
 /// `surface_tension.contact_angle`, one angle or a table of every wall and solid
@@ -361,6 +399,7 @@ mod tests {
             })),
             contact_angle: None,
             thin_layer_rows: 0,
+            colour_laplacian: false,
         };
         let s = law(1.3e-8);
         assert!(

@@ -154,6 +154,12 @@ impl CpuBackend {
     pub(crate) fn tension_smooth(&mut self) {
         surface_forces::tension_smooth(&self.params, &mut self.st, &self.grid)
     }
+    pub(crate) fn tension_colour(&mut self) {
+        surface_forces::tension_colour(&self.params, &mut self.st, &self.grid)
+    }
+    pub(crate) fn tension_laplacian(&mut self) {
+        surface_forces::tension_laplacian(&self.params, &mut self.st, &self.grid)
+    }
     pub(crate) fn recoil(&mut self) {
         surface_forces::recoil(&self.params, &mut self.st)
     }

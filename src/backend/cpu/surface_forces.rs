@@ -28,7 +28,7 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
 use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
 use crate::state::State;
-use crate::state::{H_TEMPERATURE, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_THIN};
+use crate::state::{H_TEMPERATURE, S_COLOUR, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_THIN};
 use rayon::prelude::*;
 
 /// F22 (21) f[T, T_m, T_m + ΔT_s]; 1 without a ramp. max then min, as the WGSL
@@ -272,6 +272,99 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
             for c in 0..3 {
                 st.acc[i][c] += a[c];
             }
+        }
+        st.surface[n + i][S_CURVATURE] = kappa;
+    }
+}
+
+/// J22 (5), the first dispatch of `model = "muller"`: the colour
+/// c_i = Σ_j (m_j/ρ_j) W_ij over the liquid's particles, j = i included, to
+/// surface[n + i][S_COLOUR]. J22 sums "over j" and its only phase is the droplet;
+/// here the liquid alone, so a wall under the drop does not read as more liquid.
+/// ρ_j is the state's density as printed: on summation density a surface
+/// particle's short ρ_j lengthens its volume, and c stays nearer 1 than
+/// Γ = Σ m_j/ρ0 W_ij would.
+pub fn tension_colour(pr: &Params, st: &mut State, grid: &CellTable) {
+    let (n, active) = (st.len(), st.active());
+    let s: &State = st;
+    let liquid = pr.tension.liquid;
+    let colour: Vec<Option<f32>> = (0..active)
+        .into_par_iter()
+        .map(|i| {
+            if s.phase[i] != liquid {
+                return None;
+            }
+            let mut c = 0.0f32;
+            for_each_neighbor(pr, &s.pos, grid, i, |j, _d, r2| {
+                if s.phase[j] == liquid {
+                    c += s.mass[j] / s.rho[j] * kernel::w(pr, r2.sqrt());
+                }
+            });
+            Some(c)
+        })
+        .collect();
+    for (i, c) in colour.into_iter().enumerate() {
+        if let Some(c) = c {
+            st.surface[n + i][S_COLOUR] = c;
+        }
+    }
+}
+
+/// J22 (6)–(8) after Müller et al. 2003, the second dispatch: over the liquid's
+/// neighbours j ≠ i, with V_j = m_j/ρ_j,
+///   n_i = Σ_j V_j (c_j − c_i) ∇_i W_ij                        (6)
+///   ∇²c_i = −Σ_j V_j (c_i − c_j) 2 |∇_i W_ij| / (r_ij + ε)      (7)
+///   a_i = −σ ∇²c_i n_i / (|n_i| ρ_i)                            (8) and (3)
+/// where |n_i| > 0.1/h, the interface pass's threshold (J22 prints none; without
+/// one the bulk's noise gradient sets a direction). ε = 0.01 h (J22: unstated;
+/// pairs closer than h/10 do not occur at rest). n = ∇c points into the liquid,
+/// so with κ = −∇²c/|n| (to surface[n + i][S_CURVATURE]) the force is σ κ n/ρ:
+/// inward where κ > 0, CSF's sign. σ is the constant coefficient times F22 (21)'s
+/// ramp where the liquid melts. At a free surface the colour only falls to
+/// about ½ and the outer row's Laplacian is one-sided: see docs/physics.md for
+/// what the Laplace disc measures.
+pub fn tension_laplacian(pr: &Params, st: &mut State, grid: &CellTable) {
+    let (n, active) = (st.len(), st.active());
+    let s: &State = st;
+    let liquid = pr.tension.liquid;
+    let eps = pr.kernel.h * pr.consts.tenth * pr.consts.tenth;
+    let out: Vec<Option<([f32; 3], f32)>> = (0..active)
+        .into_par_iter()
+        .map(|i| {
+            if s.phase[i] != liquid {
+                return None;
+            }
+            let c_i = s.surface[n + i][S_COLOUR];
+            let mut g = [0.0f32; 3];
+            let mut lap = 0.0f32;
+            for_each_neighbor(pr, &s.pos, grid, i, |j, d, r2| {
+                if r2 <= 0.0 || s.phase[j] != liquid {
+                    return;
+                }
+                let r = r2.sqrt();
+                let v_j = s.mass[j] / s.rho[j];
+                let dc = s.surface[n + j][S_COLOUR] - c_i;
+                let dw = kernel::dw(pr, r);
+                let f = v_j * dc * dw / r;
+                for a in 0..3 {
+                    g[a] += f * d[a];
+                }
+                lap += v_j * dc * pr.consts.two * dw.abs() / (r + eps);
+            });
+            let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            if gl <= pr.consts.tenth * pr.kernel.inv_h {
+                return Some(([0.0; 3], 0.0));
+            }
+            let kappa = -(lap / gl);
+            let t_i = temperature(pr, s, i);
+            let scale = pr.tension.alpha0 * ramp(pr, t_i) * kappa / s.rho[i];
+            Some(([scale * g[0], scale * g[1], scale * g[2]], kappa))
+        })
+        .collect();
+    for (i, o) in out.into_iter().enumerate() {
+        let Some((a, kappa)) = o else { continue };
+        for c in 0..3 {
+            st.acc[i][c] += a[c];
         }
         st.surface[n + i][S_CURVATURE] = kappa;
     }

@@ -481,6 +481,20 @@ pub struct DfsphDef {
     /// docs/physics.md); default 0, on the implicit solve's right side.
     pub cohesion: f64,
     pub adhesion: f64,
+    /// "lattice" (default): the domain's walls are as many layers of the
+    /// lattice as the kernel's support, each of volume m/ρ0; "akinci": one
+    /// layer, every wall particle's volume V_b = 1/Σ_b' W_bb' over the wall
+    /// particles (J22 (23)–(24), Akinci et al. 2012).
+    pub boundary: DfsphBoundary,
+}
+
+/// `simulation.dfsph.boundary`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DfsphBoundary {
+    #[default]
+    Lattice,
+    Akinci,
 }
 
 impl Default for DfsphDef {
@@ -495,6 +509,7 @@ impl Default for DfsphDef {
             xsph: 0.0,
             cohesion: 0.0,
             adhesion: 0.0,
+            boundary: DfsphBoundary::Lattice,
         }
     }
 }
@@ -895,6 +910,13 @@ pub struct CheckDef {
     pub r18_slice_depth: Option<f64>,
     /// remelt: the reference remelt depth (m; F22 §4.3).
     pub depth: Option<f64>,
+    /// splat: the droplet's phase (default: every liquid phase), for scenes
+    /// whose substrate is a liquid phase too (J22 §4.2).
+    pub phase: Option<String>,
+    /// splat: a reference spread factor D_max/D0 (J22 §4.2). With it the
+    /// verdict is the spread factor's relative departure from it, not J22's
+    /// Fluent-case timings.
+    pub spread_factor: Option<f64>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).

@@ -36,6 +36,57 @@ fn axis_sites(m: &Model, a: usize) -> Vec<(f64, bool)> {
     out
 }
 
+/// J22 (24), Akinci et al. (2012): a wall particle's volume is
+/// V_b = 1/Σ_b' W_bb' over the wall particles within the support, itself
+/// included, and its mass ρ0_b V_b, so every pass that takes a wall's volume as
+/// m/ρ0 (DFSPH's density, pressure and viscosity, conduction, the interface
+/// normals) reads Akinci's. A single layer so gets about the weight the
+/// missing layers had; inside a thick wall shape V_b is the lattice volume.
+/// Walls sit on lattice sites and never move on DFSPH, so the sum runs once, in
+/// f64, over integer site offsets (periodic axes wrap).
+fn akinci_wall_masses(m: &Model, st: &mut State) {
+    use std::collections::HashSet;
+    let dim = m.dim as usize;
+    let site = |p: [f32; 4]| -> [i64; 3] {
+        let x = m.to_world(p);
+        std::array::from_fn(|a| {
+            if a < dim {
+                ((x[a] - m.domain_lo[a]) / m.dx - 0.5).round() as i64
+            } else {
+                0
+            }
+        })
+    };
+    let is_wall = |ph: u32| m.phases[ph as usize].kind == crate::scene::PhaseKind::Wall;
+    let walls: Vec<usize> = (0..st.len()).filter(|&i| is_wall(st.phase[i])).collect();
+    let occupied: HashSet<[i64; 3]> = walls.iter().map(|&i| site(st.pos[i])).collect();
+    let wrap = |k: i64, a: usize| -> i64 {
+        if m.periodic[a] {
+            k.rem_euclid(m.sites[a] as i64)
+        } else {
+            k
+        }
+    };
+    let reach = (m.support / m.dx).ceil() as i64;
+    let z = if dim == 3 { reach } else { 0 };
+    for i in walls {
+        let c = site(st.pos[i]);
+        let mut sum = 0.0;
+        for da in -reach..=reach {
+            for db in -reach..=reach {
+                for dc in -z..=z {
+                    let r = m.dx * ((da * da + db * db + dc * dc) as f64).sqrt();
+                    let other = [wrap(c[0] + da, 0), wrap(c[1] + db, 1), wrap(c[2] + dc, 2)];
+                    if r < m.support && occupied.contains(&other) {
+                        sum += crate::params::kernel_w_f64(m.kernel, m.dim, m.h, r);
+                    }
+                }
+            }
+        }
+        st.mass[i] = (m.phases[st.phase[i] as usize].rho0 / sum) as f32;
+    }
+}
+
 /// Upper bound of the particle count (every lattice site occupied), for the memory
 /// check before anything is allocated.
 pub fn site_count(m: &Model) -> f64 {
@@ -364,6 +415,9 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         let ratio = crate::params::lattice_density_ratio(m.kernel, m.dim, m.h, m.dx, m.support);
         for mass in st.mass.iter_mut() {
             *mass = (*mass as f64 / ratio) as f32;
+        }
+        if m.akinci_walls {
+            akinci_wall_masses(m, &mut st);
         }
     }
     if held.continuity {

@@ -869,6 +869,19 @@ fn dfsph_spray_droplet_150_steps() {
         ],
         150,
     );
+    // J22's kernel (the cubic spline at h = Δx) over one Akinci boundary layer
+    // (wall masses ρ0/Σ_b W from setup, the same bits on both sides).
+    assert_bit_identical_at(
+        &path,
+        &[
+            "dx=4e-6",
+            "simulation.kernel=\"cubic\"",
+            "simulation.h_over_dx=1.0",
+            "simulation.dfsph={ xsph = 0.3, max_iterations = 20, viscosity_max_iterations = 20, \
+             boundary = \"akinci\" }",
+        ],
+        150,
+    );
 }
 
 /// Issue 30: DFSPH's factor, both pressure solves and the implicit viscosity

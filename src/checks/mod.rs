@@ -171,7 +171,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         }
         CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
         CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
-        CheckKind::Splat => Box::new(splat::Splat::default()),
+        CheckKind::Splat => Box::new(splat::Splat::new(m, c.phase.as_deref(), c.spread_factor)),
         CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),

@@ -110,6 +110,10 @@ pub struct Model {
     pub grid: [u32; 3],
     pub cell_size: [f64; 3],
     pub wall_layers: u32,
+    /// DFSPH's single-layer Akinci boundary (`simulation.dfsph.boundary`): one
+    /// wall layer, and setup gives each wall particle the mass ρ0 V_b with
+    /// V_b = 1/Σ_b' W_bb' (J22 (24)).
+    pub akinci_walls: bool,
     pub gravity: [f64; 3],
     pub background_pressure: f64,
     pub pressure_floor: bool,
@@ -421,7 +425,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     let sites = domain_sites(&cx, dim, domain_lo, domain_hi, dx, &mut warnings);
     box_face_warnings(&cx, scene, dim, domain_lo, dx, &mut warnings);
     let phases = phase_table(&cx, scene, dim, dx)?;
-    let wall_layers = (support / dx - 1e-9).ceil() as u32;
+    let akinci_walls = sim.formulation == crate::scene::Formulation::Dfsph
+        && sim
+            .dfsph
+            .is_some_and(|d| d.boundary == crate::scene::DfsphBoundary::Akinci);
+    let wall_layers = if akinci_walls {
+        1
+    } else {
+        (support / dx - 1e-9).ceil() as u32
+    };
     let (origin, grid, cell_size) = cell_grid(
         &cx,
         dim,
@@ -601,6 +613,27 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Thermocapillary {
             thermocapillary_layout(&cx, scene, dim, &phases, surface_tension.as_ref(), c)?;
         }
+        if c.kind == crate::scene::CheckKind::Splat {
+            if let Some(name) = &c.phase {
+                if !phases
+                    .iter()
+                    .any(|p| &p.name == name && p.kind == PhaseKind::Liquid)
+                {
+                    return Err(cx.err(
+                        "check.phase",
+                        format!("`{name}` is not a liquid phase of the scene (the droplet)"),
+                    ));
+                }
+            }
+            if let Some(xi) = c.spread_factor {
+                if !(xi.is_finite() && xi >= 1.0) {
+                    return Err(cx.err(
+                        "check.spread_factor",
+                        format!("a spread factor D_max/D0 is at least 1, got {xi}"),
+                    ));
+                }
+            }
+        }
         if c.kind == crate::scene::CheckKind::Remelt {
             let d = c.depth.unwrap_or(f64::NAN);
             if !(d.is_finite() && d >= 0.0) {
@@ -722,6 +755,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         grid,
         cell_size,
         wall_layers,
+        akinci_walls,
         gravity,
         background_pressure: sim.background_pressure,
         viscous_heating: sim.viscous_heating,
@@ -1047,6 +1081,21 @@ fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, Inpu
             ));
         }
     }
+    if d.boundary == crate::scene::DfsphBoundary::Akinci
+        && !(sim.kernel == crate::scene::KernelKind::Cubic && sim.h_over_dx == Some(1.0))
+    {
+        // A flat layer weighted by 1/ΣW stands for the wall behind it only when
+        // the kernel reaches two spacings: under the quintic's three, the first
+        // fluid row of a column at rest read 16% dense (the layer's weight 1.79
+        // lattice volumes at 0.5 dx where three layers give 47.3σ, one 81.9σ)
+        // and the column blew up at step 7.
+        return Err(cx.err(
+            "simulation.dfsph.boundary",
+            "\"akinci\" (one boundary layer) needs a kernel that reaches two spacings: \
+             J22's cubic spline at h = dx (kernel = \"cubic\", h_over_dx = 1.0); under the \
+             quintic's three the first fluid row reads 16% dense",
+        ));
+    }
     if d.xsph > 0.0 && d.viscosity == crate::scene::DfsphViscosity::Explicit {
         return Err(cx.err(
             "simulation.dfsph.xsph",
@@ -1075,13 +1124,15 @@ fn dfsph_def(cx: &Ctx, scene: &SceneFile) -> Result<crate::scene::DfsphDef, Inpu
     // hydrostatic column Wendland C2 at h = 2Δx blew up at step 1 and the cubic
     // at 1.5Δx after 240 steps (ω = ¼ held them, with errors of 8-18% and
     // 4-8%).
-    let quintic_at_dx =
-        sim.kernel == crate::scene::KernelKind::Quintic && sim.h_over_dx.is_none_or(|r| r == 1.0);
+    let at_dx = |k| sim.kernel == k && sim.h_over_dx.is_some_and(|r| r == 1.0);
+    let quintic_at_dx = (sim.kernel == crate::scene::KernelKind::Quintic
+        && sim.h_over_dx.is_none_or(|r| r == 1.0))
+        || at_dx(crate::scene::KernelKind::Cubic);
     if !quintic_at_dx {
         return refuse(
             "simulation.kernel",
-            "only the quintic kernel at h = dx yet (its pressure solve diverges with \
-             the larger supports of wendland_c2 and cubic)",
+            "only the quintic or the cubic (J22's) at h = dx yet (the pressure solve \
+             diverges with the larger supports of wendland_c2 and of cubic at 1.5 dx)",
         );
     }
     if sim.initial_pressure != crate::scene::InitialPressure::Zero {

@@ -21,3 +21,24 @@ fn material_jetting_scenes_validate_and_need_their_reference_depth() {
         );
     }
 }
+
+/// J22 §4.2's three spreads on a meltable 440C substrate (issue 30; 2.5 to 7
+/// minutes each on 2 cores, so run by hand: their headers give the figures).
+/// Each validates with the droplet and the substrate as liquid phases, and the
+/// splat check compares D_max/D0 with J22's value for its diameter.
+#[test]
+fn spread_scenes_validate_with_j22_spread_factors() {
+    for (d0, xi) in [("30", "2.0"), ("45", "2.22"), ("62", "2.29")] {
+        let scene = common::scene_at(&format!("spray/j22_spread_{d0}um_3d"));
+        let out = common::spatter(&["validate", &scene]);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(0), "{d0}: {o}{e}");
+        assert!(o.contains("substrate (Liquid)"), "{d0}: {o}");
+        assert!(!o.contains("warning"), "{d0}: {o}");
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert!(
+            text.contains(&format!("spread_factor = {xi}")),
+            "{d0}: the check's reference is J22's {xi}"
+        );
+    }
+}

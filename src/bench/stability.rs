@@ -111,6 +111,9 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
     (scene_file!("spray/j22_fluent_case_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_3d"), &[]),
+    (scene_file!("spray/j22_spread_30um_3d"), &[]),
+    (scene_file!("spray/j22_spread_45um_3d"), &[]),
+    (scene_file!("spray/j22_spread_62um_3d"), &[]),
     (scene_file!("mjt/drop_on_hot_substrate_3d"), &[]),
     (scene_file!("mjt/drop_on_cold_substrate_3d"), &[]),
 ];

@@ -4,8 +4,22 @@
 // Heat conduction in enthalpy form and temperature from enthalpy.
 // Twin of src/backend/cpu/heat.rs (equations there): J22 (19)-(22), (25); F22 (41).
 
-// Conductivity at liquid fraction fl, linear between the solid and liquid values.
-fn conductivity(ph: u32, fl: f32) -> f32 {
+// Conductivity at temperature t and liquid fraction fl: the phase's
+// conductivity_table lambda(T) (held at its ends), else linear in fl between the
+// solid and liquid values. Twin of conductivity in src/backend/cpu/heat.rs.
+fn conductivity(ph: u32, t: f32, fl: f32) -> f32 {
+    if ((P.sizes.flags & FLAG_CONDUCTIVITY_TABLE) != 0u && P.phases[ph].conductivity_points > 0u) {
+        let tt = max(t, P.phases[ph].conductivity_law[0].temperature[0]);
+        var k = 0u;
+        for (var i = 1u; i < P.phases[ph].conductivity_points; i = i + 1u) {
+            if (tt >= P.phases[ph].conductivity_law[i / 4u].temperature[i % 4u]) {
+                k = i;
+            }
+        }
+        let row = k / 4u;
+        let c = k % 4u;
+        return P.phases[ph].conductivity_law[row].value[c] + P.phases[ph].conductivity_law[row].slope[c] * (tt - P.phases[ph].conductivity_law[row].temperature[c]);
+    }
     let ks = P.phases[ph].conductivity;
     return ks + fl * (P.phases[ph].liquid_conductivity - ks);
 }
@@ -59,7 +73,7 @@ fn mirror_temperature(i: u32) {
 // minus the surface losses.
 fn conduction_rate(i: u32, laser_source: f32) -> f32 {
     let ph_i = phase[i];
-    let k_i = conductivity(ph_i, heat[i][H_LIQUID]);
+    let k_i = conductivity(ph_i, heat[i][H_TEMPERATURE], heat[i][H_LIQUID]);
     let t_i = heat[i][H_TEMPERATURE];
     let eta2 = P.kernel.eta2;
     let pi = pos[i];
@@ -72,7 +86,7 @@ fn conduction_rate(i: u32, laser_source: f32) -> f32 {
         let ph_j = phase[j];
         var k_ij = 0.0;
         if (conducts(ph_j)) {
-            let k_j = conductivity(ph_j, heat[j][H_LIQUID]);
+            let k_j = conductivity(ph_j, heat[j][H_TEMPERATURE], heat[j][H_LIQUID]);
             // Ordered operands: both sides of a pair get the same bits.
             k_ij = c_four() * min(k_i, k_j) * max(k_i, k_j) / (k_i + k_j);
         } else if ((heat_flags(ph_j) & HEAT_DIRICHLET) != 0u) {
@@ -262,6 +276,9 @@ fn surface_loss(ph: u32, t: f32, delta: f32) -> f32 {
 // (T, f_l) of the stored enthalpy h (relative to h(T_ref); T_ref = solidus when
 // the phase melts). Twin of temperature_of in src/backend/cpu/heat.rs.
 fn temperature_of(ph: u32, h: f32) -> vec2<f32> {
+    if (P.phases[ph].enthalpy_points > 0u) {
+        return table_temperature_of(ph, h);
+    }
     let c_s = P.phases[ph].heat_capacity;
     let band = P.phases[ph].band_enthalpy;
     let t_s = P.phases[ph].solidus;
@@ -278,6 +295,27 @@ fn temperature_of(ph: u32, h: f32) -> vec2<f32> {
     let b = P.phases[ph].band_capacity;
     let x = c_two() * h / (b + sqrt(b * b + c_four() * a * h));
     return vec2<f32>(t_s + x, x / (t_l - t_s));
+}
+
+// (T, f_l) of h on an enthalpy_table: the segment whose point value h reaches,
+// continued past the ends; f_l linear in T over the melting band. Twin of
+// table_temperature_of in src/backend/cpu/heat.rs.
+fn table_temperature_of(ph: u32, h: f32) -> vec2<f32> {
+    var k = 0u;
+    for (var i = 1u; i < P.phases[ph].enthalpy_points; i = i + 1u) {
+        if (h >= P.phases[ph].enthalpy[i / 4u].value[i % 4u]) {
+            k = i;
+        }
+    }
+    let row = k / 4u;
+    let c = k % 4u;
+    let t = P.phases[ph].enthalpy[row].temperature[c] + (h - P.phases[ph].enthalpy[row].value[c]) / P.phases[ph].enthalpy[row].slope[c];
+    let flags = heat_flags(ph);
+    if ((flags & HEAT_MELTS) != 0u) {
+        let fl = (t - P.phases[ph].solidus) / (P.phases[ph].liquidus - P.phases[ph].solidus);
+        return vec2<f32>(t, min(max(fl, 0.0), c_one()));
+    }
+    return vec2<f32>(t, select(0.0, 1.0, (flags & HEAT_LIQUID) != 0u));
 }
 
 // A PHASE_PROGRAM phase's temperature at time t. Twin of

@@ -57,6 +57,9 @@ pub const FLAG_DFSPH: u32 = 131072;
 /// Free-surface tension by J22 (5)-(8)'s colour Laplacian (`model = "muller"`):
 /// the `tension_colour` and `tension_laplacian` dispatches replace R18's CSF pair.
 pub const FLAG_COLOUR_TENSION: u32 = 262144;
+/// Some phase has a `conductivity_table`: the conduction's per-pair λ looks it
+/// up (a scene-wide flag, so that other scenes' pair loops skip the test).
+pub const FLAG_CONDUCTIVITY_TABLE: u32 = 524288;
 /// A phase index that names no phase (`tension.gas` of the free-surface form).
 pub const NO_PHASE: u32 = u32::MAX;
 
@@ -351,14 +354,24 @@ gpu_struct! {
         /// dynamic viscosity μ it solves with; `eta` is then 0 (the forces
         /// pass has no explicit viscous term and the time step no viscous limit).
         pub implicit_eta: f32,
-        pub density: [DensityPoints; 2],
+        /// `enthalpy_table` (0: none): point k is enthalpy[k / 4]'s component
+        /// k % 4, its value h_k − h(T_ref) and the slope to the next point (the
+        /// last: the last segment's, continued).
+        pub enthalpy_points: u32,
+        /// `conductivity_table` (0: none): λ_k and the slope to the next point
+        /// (the last: 0, held).
+        pub conductivity_points: u32,
+        pub density: [LawPoints; 2],
+        pub enthalpy: [LawPoints; 2],
+        pub conductivity_law: [LawPoints; 2],
     }
 }
 
 gpu_struct! {
-    /// Four points of a phase's density law ρ0(T) (model::expansion::DensityLaw):
-    /// ρ0 = value[k] + slope[k] (T − temperature[k]) from point k to the next.
-    pub struct DensityPoints {
+    /// Four points of a phase's piecewise-linear law y(T): the density law ρ0(T)
+    /// (model::expansion::DensityLaw), the enthalpy h(T), the conductivity λ(T):
+    /// y = value[k] + slope[k] (T − temperature[k]) from point k to the next.
+    pub struct LawPoints {
         pub temperature: glam::Vec4,
         pub value: glam::Vec4,
         pub slope: glam::Vec4,
@@ -613,6 +626,9 @@ impl Params {
         };
         for (i, ph) in m.phases.iter().enumerate() {
             p.phases[i] = phase_block(ph);
+            if p.phases[i].conductivity_points > 0 {
+                p.sizes.flags |= FLAG_CONDUCTIVITY_TABLE;
+            }
             if m.implicit_viscosity() {
                 p.phases[i].implicit_eta = p.phases[i].eta;
                 p.phases[i].eta = 0.0;
@@ -1140,6 +1156,29 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
             row.temperature[k % 4] = t as f32;
             row.value[k % 4] = r as f32;
             row.slope[k % 4] = s as f32;
+        }
+    }
+    if let Some(table) = &t.enthalpy_table {
+        b.enthalpy_points = table.n as u32;
+        let h_ref = t.reference_enthalpy();
+        for (k, &(tk, hk)) in table.points().iter().enumerate() {
+            let row = &mut b.enthalpy[k / 4];
+            row.temperature[k % 4] = tk as f32;
+            row.value[k % 4] = (hk - h_ref) as f32;
+            row.slope[k % 4] = table.slope(k) as f32;
+        }
+    }
+    if let Some(table) = &t.conductivity_table {
+        b.conductivity_points = table.n as u32;
+        for (k, &(tk, lk)) in table.points().iter().enumerate() {
+            let row = &mut b.conductivity_law[k / 4];
+            row.temperature[k % 4] = tk as f32;
+            row.value[k % 4] = lk as f32;
+            row.slope[k % 4] = if k + 1 < table.n {
+                table.slope(k) as f32
+            } else {
+                0.0
+            };
         }
     }
     b

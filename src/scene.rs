@@ -635,6 +635,16 @@ pub struct Material {
     /// `density` stays the nominal value (sound speed from `reference_pressure`,
     /// the surface terms' volumes m/ρ0).
     pub density_law: Option<Vec<Vec<f64>>>,
+    /// Specific enthalpy h(T) = ∫_0^T c_p dT with the latent heat (J22 (19),
+    /// §4.2): 2 to 8 points [T (K), h (J/kg)], both rising, linear between them
+    /// and continued along the first and last segments. Replaces
+    /// `heat_capacity`, `liquid_heat_capacity` and `latent_heat` (solidus and
+    /// liquidus still give the liquid fraction).
+    pub enthalpy_table: Option<Vec<Vec<f64>>>,
+    /// Conductivity λ(T): 2 to 8 points [T (K), λ (W/(m K))] in rising
+    /// temperature, linear between them and held at the end values beyond.
+    /// Replaces `conductivity` and `liquid_conductivity`.
+    pub conductivity_table: Option<Vec<Vec<f64>>>,
 }
 
 /// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),

@@ -155,6 +155,8 @@ fn compare_cli_dam_break_3d_200_steps() {
 fn heat_passes_200_steps() {
     assert_bit_identical("stefan_1d", &[], 200);
     assert_bit_identical("conduction_two_materials", &[], 200);
+    // h(T) and λ(T) from tables (issue 30).
+    assert_bit_identical("conduction_tables_2d", &[], 200);
     assert_bit_identical("adiabatic_box", &[], 200);
     assert_bit_identical("laser_flat_plate", &[], 200);
     assert_bit_identical(

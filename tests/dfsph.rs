@@ -167,7 +167,8 @@ fn akinci_boundary_holds_the_column_with_one_layer() {
     let (o, e) = common::text(&out);
     assert_eq!(out.status.code(), Some(0), "{o}{e}");
     assert!(
-        o.lines().any(|l| l.starts_with("check splat") && l.ends_with("PASS")),
+        o.lines()
+            .any(|l| l.starts_with("check splat") && l.ends_with("PASS")),
         "{o}"
     );
 }
@@ -243,7 +244,10 @@ fn dfsph_keys_are_checked() {
             "simulation.dfsph.boundary=\"akinci\"",
             "simulation.dfsph.boundary",
         ),
-        ("simulation.dfsph.boundary=\"one_layer\"", "simulation.dfsph.boundary"),
+        (
+            "simulation.dfsph.boundary=\"one_layer\"",
+            "simulation.dfsph.boundary",
+        ),
     ] {
         common::assert_input_error(&["validate", &dfsph, "--set", set], key);
     }

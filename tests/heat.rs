@@ -506,3 +506,167 @@ fn a_laser_run_stops_when_the_melt_has_solidified() {
         "run.stop_grace",
     );
 }
+
+/// The two-material bar with both materials' properties given as tables
+/// (`enthalpy_table`, `conductivity_table`), written to a scratch scene.
+fn tabled_bar(name: &str, enthalpy: &str, conductivity: &str) -> String {
+    let text = std::fs::read_to_string(scene("conduction_two_materials")).unwrap();
+    let mut out = String::new();
+    for line in text.lines() {
+        let t = line.trim_start();
+        if t.starts_with("heat_capacity") {
+            out.push_str(&format!("enthalpy_table = {enthalpy}\n"));
+        } else if t.starts_with("conductivity") {
+            out.push_str(&format!("conductivity_table = {conductivity}\n"));
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    let path = common::scratch(name).with_extension("toml");
+    std::fs::write(&path, out).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+/// Tables that repeat the constant material (c = 1000 J/(kg K), λ = 1 W/(m K)
+/// in both layers: the check's two-layer reference then holds with k1 = k2)
+/// give the constant material's steady profile: the check's figure to 1e-4 of
+/// the temperature scale (the stored enthalpy's origin differs, so the bits do).
+#[test]
+fn tables_that_repeat_constants_give_the_same_profile() {
+    let same = tabled_bar(
+        "tabled_constant_bar",
+        "[[200.0, 2.0e5], [600.0, 6.0e5]]",
+        "[[200.0, 1.0], [600.0, 1.0]]",
+    );
+    let tabled = common::run_path(&same, &[], None).check.expect("a check");
+    let constant = run_check(
+        "conduction_two_materials",
+        &["materials.high_k.conductivity=1.0"],
+    );
+    assert!(
+        (tabled.value - constant.value).abs() < 1e-4,
+        "tabled {} against constant {}",
+        tabled.line(),
+        constant.line()
+    );
+}
+
+/// scenarios/validation/conduction_tables_2d: λ(T) = 1 + 0.01 (T − 300) W/(m K)
+/// (1 at the cold wall, 3 at the hot one) and an h(T) whose slope steps at
+/// 400 K. The steady profile is linear in Kirchhoff's
+/// Θ = ∫_300^T λ dT = (T − 300) + 0.005 (T − 300)², Θ = 400 (1 − y/L), so
+/// T = 300 + (√(1 + 0.02 Θ) − 1)/0.01; a constant λ would give the straight
+/// line 200 (1 − y/L), up to 25 K (12%) away in the middle. Every particle
+/// within 1% of the 200 K scale (the conduction tolerance; measured 0.63%).
+#[test]
+fn conductivity_table_gives_kirchhoffs_steady_profile() {
+    let (loaded, r) = common::run_loaded(&scene("conduction_tables_2d"), &[], None);
+    let m = &loaded.model;
+    let st = &r.final_state;
+    let l = 0.02;
+    let mut worst: f64 = 0.0;
+    for i in 0..st.active() {
+        if !m.phases[st.phase[i] as usize].conducts() {
+            continue;
+        }
+        let y = m.to_world(st.pos[i])[1];
+        let theta = 400.0 * (1.0 - y / l);
+        let exact = 300.0 + ((1.0 + 0.02 * theta).sqrt() - 1.0) / 0.01;
+        let t = st.heat[i][spatter::state::H_TEMPERATURE] as f64;
+        worst = worst.max((t - exact).abs() / 200.0);
+    }
+    assert!(
+        worst < CONDUCTION_TOLERANCE,
+        "largest error {worst:.4} of 200 K"
+    );
+    println!("lambda(T) bar: largest error {worst:.3e} of 200 K");
+}
+
+/// Table input: each bad table and each constant it replaces exits 2 naming the key.
+#[test]
+fn bad_tables_name_the_key() {
+    let tabled = tabled_bar(
+        "tabled_bad_bar",
+        "[[200.0, 2.0e5], [600.0, 6.0e5]]",
+        "[[200.0, 1.0], [600.0, 1.0]]",
+    );
+    for (set, key) in [
+        (
+            "materials.low_k.enthalpy_table=[[300.0, 3.0e5]]",
+            "materials.low_k.enthalpy_table",
+        ),
+        (
+            "materials.low_k.enthalpy_table=[[300.0, 3.0e5], [200.0, 4.0e5]]",
+            "materials.low_k.enthalpy_table",
+        ),
+        (
+            "materials.low_k.enthalpy_table=[[300.0, 3.0e5], [400.0, 2.0e5]]",
+            "materials.low_k.enthalpy_table",
+        ),
+        (
+            "materials.low_k.conductivity_table=[[300.0, -1.0], [400.0, 2.0]]",
+            "materials.low_k.conductivity_table",
+        ),
+    ] {
+        common::assert_input_error(&["validate", &tabled, "--set", set], key);
+    }
+    for (set, key) in [
+        (
+            "materials.low_k.heat_capacity=1000.0",
+            "materials.low_k.heat_capacity",
+        ),
+        (
+            "materials.low_k.latent_heat=1.0e5",
+            "materials.low_k.latent_heat",
+        ),
+        (
+            "materials.low_k.conductivity=1.0",
+            "materials.low_k.conductivity",
+        ),
+    ] {
+        common::assert_input_error(&["validate", &tabled, "--set", set], key);
+    }
+}
+
+/// An enthalpy table through the band model's own points (c = 1000 J/(kg K),
+/// L = 1e5 J/kg spread over [599.5, 600.5] K: the kinks of h(T) are the table's
+/// points) melts stefan_1d's bar as the constants do: every particle's
+/// temperature after 200 s within 0.1 K of the constant material's (of 100 K
+/// over the bar; the stored enthalpy's origin and so its rounding differ).
+#[test]
+fn enthalpy_table_with_latent_heat_melts_as_the_band_model() {
+    let text = std::fs::read_to_string(scene("stefan_1d")).unwrap();
+    let table =
+        "enthalpy_table = [[500.0, 5.0e5], [599.5, 5.995e5], [600.5, 7.005e5], [800.0, 9.0e5]]\n";
+    let mut out = String::new();
+    for line in text.lines() {
+        let t = line.trim_start();
+        if t.starts_with("heat_capacity") {
+            out.push_str(table);
+        } else if !t.starts_with("latent_heat") {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    let path = common::scratch("tabled_stefan").with_extension("toml");
+    std::fs::write(&path, out).unwrap();
+    let tabled = common::run_path(&path.to_string_lossy(), &[], None).final_state;
+    let constant = common::run_path(&scene("stefan_1d"), &[], None).final_state;
+    assert_eq!(tabled.active(), constant.active());
+    let t = spatter::state::H_TEMPERATURE;
+    let (mut worst, mut melted) = (0.0f32, 0);
+    for i in 0..tabled.active() {
+        assert_eq!(tabled.id[i], constant.id[i]);
+        worst = worst.max((tabled.heat[i][t] - constant.heat[i][t]).abs());
+        if constant.heat[i][t] > 600.5 && constant.phase[i] == tabled.phase[i] {
+            melted += 1;
+        }
+    }
+    assert!(
+        melted > 100,
+        "the bar melts ({melted} particles above the liquidus)"
+    );
+    assert!(worst < 0.1, "largest temperature difference {worst} K");
+    println!("tabled Stefan bar: largest temperature difference {worst:.3e} K");
+}

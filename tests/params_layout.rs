@@ -378,6 +378,7 @@ fn flag_and_code_constants_match() {
         ("FLAG_MARRONE_VISCOSITY", rs::FLAG_MARRONE_VISCOSITY),
         ("FLAG_DFSPH", rs::FLAG_DFSPH),
         ("FLAG_COLOUR_TENSION", rs::FLAG_COLOUR_TENSION),
+        ("FLAG_CONDUCTIVITY_TABLE", rs::FLAG_CONDUCTIVITY_TABLE),
         ("NO_BODY", spatter::state::NO_BODY),
         ("NO_PHASE", rs::NO_PHASE),
         ("KIND_LIQUID", rs::KIND_LIQUID),

@@ -166,12 +166,17 @@ struct Phase {
     program_rate: f32,
     program_until: f32,
     implicit_eta: f32,       // DFSPH implicit viscosity's mu (eta is then 0)
-    density: array<DensityPoints, 2>,
+    enthalpy_points: u32,    // enthalpy_table (0: none): h - h(T_ref) at point k is enthalpy[k / 4].value[k % 4]
+    conductivity_points: u32, // conductivity_table (0: none), in conductivity_law
+    density: array<LawPoints, 2>,
+    enthalpy: array<LawPoints, 2>,
+    conductivity_law: array<LawPoints, 2>,
 }
 
-// Four points of a density law rho0(T): rho0 = value + slope (T - temperature)
-// from a point to the next (model::expansion::DensityLaw).
-struct DensityPoints {
+// Four points of a piecewise-linear law y(T): y = value + slope (T - temperature)
+// from a point to the next (the density law rho0(T), the enthalpy h(T), the
+// conductivity lambda(T)).
+struct LawPoints {
     temperature: vec4<f32>,
     value: vec4<f32>,
     slope: vec4<f32>,
@@ -305,6 +310,7 @@ const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768u;
 const FLAG_SOLIDIFICATION: u32 = 65536u;
 const FLAG_DFSPH: u32 = 131072u;
 const FLAG_COLOUR_TENSION: u32 = 262144u;
+const FLAG_CONDUCTIVITY_TABLE: u32 = 524288u;
 const NO_BODY: u32 = 4294967295u;
 // body[id] of a particle that solidified in this step, until body_bond.
 const BODY_SOLIDIFIED: u32 = 4294967294u;

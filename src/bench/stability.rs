@@ -37,6 +37,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/collision_2d"), &[]),
     (scene_file!("validation/column_expansion_2d"), &["dx=0.1"]),
     (scene_file!("validation/conduction_two_materials"), &[]),
+    (scene_file!("validation/conduction_tables_2d"), &[]),
     (
         scene_file!("validation/couette_2d"),
         &["dx=6.666666666666667e-5"],

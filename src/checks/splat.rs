@@ -234,8 +234,14 @@ impl Check for Splat {
             .max(rel(zero, J22_ZERO_CROSSING))
             .max(late);
         let (metric, value) = match self.reference_spread {
-            Some(r) => ("relative departure of the spread factor D_max/D0 from the reference", (xi - r).abs() / r),
-            None => ("largest relative departure from J22's impact, zero-crossing and stop times", timings),
+            Some(r) => (
+                "relative departure of the spread factor D_max/D0 from the reference",
+                (xi - r).abs() / r,
+            ),
+            None => (
+                "largest relative departure from J22's impact, zero-crossing and stop times",
+                timings,
+            ),
         };
         let mut figures = vec![
             ("spread_factor".to_string(), xi),

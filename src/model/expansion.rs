@@ -122,6 +122,12 @@ pub(super) fn expansion_table(
         if let Some(p) = &def.temperature_program {
             let key = format!("phases.{}.temperature_program", ph.name);
             let program = temperature_program(cx, scene, ph, &key, p)?;
+            if ph.thermal.is_some_and(|t| t.enthalpy_table.is_some()) {
+                return Err(cx.err(
+                    &key,
+                    "imposes T through h = c_p (T - T_ref): not with an enthalpy_table",
+                ));
+            }
             if let Some(t) = ph.thermal.as_mut() {
                 t.program = Some(program);
             }

@@ -45,6 +45,55 @@ pub struct Thermal {
     pub wave: Option<TemperatureWave>,
     /// `temperature_program`: T(t) imposed instead of the heat equation.
     pub program: Option<super::expansion::TemperatureProgram>,
+    /// `enthalpy_table`: h(T) (J/kg) in place of heat_capacity and latent_heat;
+    /// `heat_capacity` then holds its smallest slope and `liquid.1` its last
+    /// (the conduction limit and the evaporation loss's c_p).
+    pub enthalpy_table: Option<LawTable>,
+    /// `conductivity_table`: λ(T); `conductivity` and `liquid.0` then hold its
+    /// largest value (the conduction limit).
+    pub conductivity_table: Option<LawTable>,
+}
+
+/// Most points a material's h(T) or λ(T) table takes (two rows of four in the
+/// parameter block, as the density law).
+pub const MAX_LAW_POINTS: usize = 8;
+
+/// A piecewise-linear law y(T) through `n` points (T rising).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawTable {
+    pub points: [(f64, f64); MAX_LAW_POINTS],
+    pub n: usize,
+}
+
+impl LawTable {
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points[..self.n]
+    }
+    /// The slope of segment k (k = n − 1: the last segment's again).
+    pub fn slope(&self, k: usize) -> f64 {
+        let k = k.min(self.n - 2);
+        let (a, b) = (self.points[k], self.points[k + 1]);
+        (b.1 - a.1) / (b.0 - a.0)
+    }
+    /// y(T), continued along the end segments.
+    pub fn extrapolated(&self, t: f64) -> f64 {
+        let k = (1..self.n)
+            .filter(|&i| t >= self.points[i].0)
+            .last()
+            .unwrap_or(0);
+        self.points[k].1 + self.slope(k) * (t - self.points[k].0)
+    }
+    /// y(T), held at the end values beyond.
+    pub fn clamped(&self, t: f64) -> f64 {
+        let (lo, hi) = (self.points[0], self.points[self.n - 1]);
+        if t <= lo.0 {
+            lo.1
+        } else if t >= hi.0 {
+            hi.1
+        } else {
+            self.extrapolated(t)
+        }
+    }
 }
 
 /// A cosine temperature along one axis (`phases.<name>.temperature_wave`).
@@ -101,8 +150,12 @@ impl Thermal {
     }
     /// Specific enthalpy h(T) = ∫_0^T c_p dT + L f_l(T) (J22 (19)): c_p is the
     /// solid's below the solidus, the liquid's above the liquidus and linear in
-    /// between, where the latent heat is spread linearly too.
+    /// between, where the latent heat is spread linearly too; or the material's
+    /// `enthalpy_table`.
     pub fn enthalpy(&self, t: f64) -> f64 {
+        if let Some(table) = &self.enthalpy_table {
+            return table.extrapolated(t);
+        }
         let cs = self.heat_capacity;
         let Some((ts, tl, l)) = self.melting else {
             return cs * t;

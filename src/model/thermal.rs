@@ -2,6 +2,7 @@
 //! radiation) from the scene's heat keys, and the host-side heat physics the
 //! diagnostics and checks evaluate in f64 (absolute enthalpy, radiated flux).
 
+use super::phases::{LawTable, MAX_LAW_POINTS};
 use super::*;
 
 /// Stefan–Boltzmann constant σ (W m⁻² K⁻⁴; CODATA 2018, exact in SI). The one
@@ -69,6 +70,8 @@ pub(super) fn thermal_table(
                 mushy_damping: 0.0,
                 wave,
                 program: None,
+                enthalpy_table: None,
+                conductivity_table: None,
             });
             continue;
         }
@@ -78,10 +81,70 @@ pub(super) fn thermal_table(
                 None => Err(cx.err(&mkey(k), "missing: needed by a phase with a temperature")),
             }
         };
-        let conductivity = need("conductivity", mat.conductivity)?;
-        let heat_capacity = need("heat_capacity", mat.heat_capacity)?;
+        let enthalpy_table = match &mat.enthalpy_table {
+            None => None,
+            Some(points) => {
+                for (k, v) in [
+                    ("heat_capacity", mat.heat_capacity),
+                    ("liquid_heat_capacity", mat.liquid_heat_capacity),
+                    ("latent_heat", mat.latent_heat),
+                ] {
+                    if v.is_some() {
+                        return Err(cx.err(
+                            &mkey(k),
+                            "the enthalpy_table holds it: give one or the other",
+                        ));
+                    }
+                }
+                Some(law_table(cx, &mkey("enthalpy_table"), points, true)?)
+            }
+        };
+        let conductivity_table = match &mat.conductivity_table {
+            None => None,
+            Some(points) => {
+                for (k, v) in [
+                    ("conductivity", mat.conductivity),
+                    ("liquid_conductivity", mat.liquid_conductivity),
+                ] {
+                    if v.is_some() {
+                        return Err(cx.err(
+                            &mkey(k),
+                            "the conductivity_table holds it: give one or the other",
+                        ));
+                    }
+                }
+                Some(law_table(cx, &mkey("conductivity_table"), points, false)?)
+            }
+        };
+        // With a table, the constants the time-step limit reads are its
+        // extremes: the largest λ and the smallest dh/dT.
+        let conductivity = match &conductivity_table {
+            Some(t) => t.points().iter().map(|p| p.1).fold(0.0, f64::max),
+            None => need("conductivity", mat.conductivity)?,
+        };
+        let heat_capacity = match &enthalpy_table {
+            Some(t) => (0..t.n - 1)
+                .map(|k| t.slope(k))
+                .fold(f64::INFINITY, f64::min),
+            None => need("heat_capacity", mat.heat_capacity)?,
+        };
         let melting = match (mat.solidus, mat.liquidus, mat.latent_heat) {
             (None, None, None) => None,
+            (Some(ts), Some(tl), None) if enthalpy_table.is_some() => {
+                cx.positive(&mkey("solidus"), ts)?;
+                if !(tl > ts && tl.is_finite()) {
+                    return Err(cx.err(
+                        &mkey("liquidus"),
+                        format!("must exceed the solidus {ts} K (got {tl})"),
+                    ));
+                }
+                // The latent heat is in the table; what the checks and
+                // diagnostics read as L is the band's enthalpy beyond the
+                // smallest slope's sensible heat.
+                let t = enthalpy_table.as_ref().unwrap();
+                let band = t.extrapolated(tl) - t.extrapolated(ts);
+                Some((ts, tl, (band - heat_capacity * (tl - ts)).max(0.0)))
+            }
             (Some(ts), Some(tl), Some(l)) => {
                 cx.positive(&mkey("solidus"), ts)?;
                 if !(tl > ts && tl.is_finite()) {
@@ -132,7 +195,10 @@ pub(super) fn thermal_table(
             None => 0.0,
         };
         let liquid = match (mat.liquid_conductivity, mat.liquid_heat_capacity) {
-            (None, None) => (conductivity, heat_capacity),
+            (None, None) => (
+                conductivity,
+                enthalpy_table.map_or(heat_capacity, |t| t.slope(t.n - 1)),
+            ),
             _ if melting.is_none() => {
                 return Err(cx.err(
                     &mkey("liquid_conductivity"),
@@ -161,9 +227,65 @@ pub(super) fn thermal_table(
             mushy_damping,
             wave,
             program: None,
+            enthalpy_table,
+            conductivity_table,
         });
     }
     Ok(())
+}
+
+/// `enthalpy_table` or `conductivity_table`: 2 to MAX_LAW_POINTS points [T, y],
+/// T rising and positive; y positive, and rising for an enthalpy (so T(h) is
+/// one-valued).
+fn law_table(
+    cx: &Ctx,
+    key: &str,
+    points: &[Vec<f64>],
+    rising: bool,
+) -> Result<LawTable, InputError> {
+    let what = if rising {
+        "h in J/kg"
+    } else {
+        "lambda in W/(m K)"
+    };
+    if !(2..=MAX_LAW_POINTS).contains(&points.len()) {
+        return Err(cx.err(
+            key,
+            format!(
+                "give 2 to {MAX_LAW_POINTS} points [T in K, {what}] (got {})",
+                points.len()
+            ),
+        ));
+    }
+    let mut table = LawTable {
+        points: [(0.0, 0.0); MAX_LAW_POINTS],
+        n: points.len(),
+    };
+    for (i, p) in points.iter().enumerate() {
+        let [t, y] = p[..] else {
+            return Err(cx.err(key, format!("point {i}: give [T in K, {what}]")));
+        };
+        if !(t.is_finite() && t > 0.0 && y.is_finite() && y > 0.0) {
+            return Err(cx.err(
+                key,
+                format!("point {i}: T and the value must be finite and positive, got [{t}, {y}]"),
+            ));
+        }
+        if i > 0 {
+            let (t0, y0) = table.points[i - 1];
+            if t <= t0 || (rising && y <= y0) {
+                return Err(cx.err(
+                    key,
+                    format!(
+                        "point {i}: T must rise{} from point to point, got [{t0}, {y0}] then [{t}, {y}]",
+                        if rising { " and h with it" } else { "" }
+                    ),
+                ));
+            }
+        }
+        table.points[i] = (t, y);
+    }
+    Ok(table)
 }
 
 /// `phases.<name>.temperature_wave`: amplitude below the temperature (T > 0

@@ -27,8 +27,8 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_INTERFACE, FLAG_SOLIDIFICATION, HEAT_DIRICHLET, HEAT_LIQUID,
-    HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
+    Params, FLAG_BODIES, FLAG_CONDUCTIVITY_TABLE, FLAG_INTERFACE, FLAG_SOLIDIFICATION,
+    HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
 use crate::state::{State, BODY_SOLIDIFIED};
@@ -88,7 +88,7 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
     let (pos, rho, mass, phase, heat) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let eta2 = pr.kernel.eta2;
     let ph_i = phase[i];
-    let k_i = conductivity(pr, ph_i, heat[i][H_LIQUID]);
+    let k_i = conductivity(pr, ph_i, heat[i][H_TEMPERATURE], heat[i][H_LIQUID]);
     let t_i = heat[i][H_TEMPERATURE];
     let mut sum = 0.0f32;
     for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
@@ -97,7 +97,7 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
         }
         let ph_j = phase[j];
         let k_ij = if pr.conducts(ph_j) {
-            let k_j = conductivity(pr, ph_j, heat[j][H_LIQUID]);
+            let k_j = conductivity(pr, ph_j, heat[j][H_TEMPERATURE], heat[j][H_LIQUID]);
             // Ordered operands: i and j compute the same bits, so the
             // pair's fluxes cancel exactly in the total enthalpy.
             4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
@@ -325,6 +325,9 @@ pub fn vapour_pressure(pr: &Params, phase: u32, t: f32) -> f32 {
 #[inline(always)]
 pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     let m = pr.phase(phase);
+    if m.enthalpy_points > 0 {
+        return table_temperature_of(pr, phase, h);
+    }
     let flags = m.flags;
     if flags & HEAT_MELTS == 0 {
         let fl = if flags & HEAT_LIQUID != 0 { 1.0 } else { 0.0 };
@@ -344,11 +347,50 @@ pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     }
 }
 
-/// Conductivity at liquid fraction f_l: solid's plus f_l times the liquid's excess.
+/// (T, f_l) of the stored enthalpy on the phase's `enthalpy_table` (J22 (19),
+/// tabulated): T = T_k + (h − h_k)/s_k on the last segment k whose point h_k
+/// the enthalpy reaches (k = 0 below the first, the last segment continued
+/// above); f_l = (T − T_s)/(T_l − T_s) clamped to [0, 1] for a melting
+/// material (the table holds the latent heat; the band only says how liquid).
 #[inline(always)]
-pub fn conductivity(pr: &Params, phase: u32, fl: f32) -> f32 {
-    let ks = pr.phases[phase as usize].conductivity;
-    ks + fl * (pr.phases[phase as usize].liquid_conductivity - ks)
+fn table_temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
+    let m = pr.phase(phase);
+    let mut k = 0usize;
+    for i in 1..m.enthalpy_points as usize {
+        if h >= m.enthalpy[i / 4].value[i % 4] {
+            k = i;
+        }
+    }
+    let row = &m.enthalpy[k / 4];
+    let c = k % 4;
+    let t = row.temperature[c] + (h - row.value[c]) / row.slope[c];
+    if m.flags & HEAT_MELTS != 0 {
+        let fl = (t - m.solidus) / (m.liquidus - m.solidus);
+        return (t, fl.max(0.0).min(1.0));
+    }
+    (t, if m.flags & HEAT_LIQUID != 0 { 1.0 } else { 0.0 })
+}
+
+/// Conductivity at temperature t and liquid fraction f_l: the phase's
+/// `conductivity_table` λ(T), linear between its points and held at its end
+/// values; else the solid's plus f_l times the liquid's excess.
+#[inline(always)]
+pub fn conductivity(pr: &Params, phase: u32, t: f32, fl: f32) -> f32 {
+    let m = &pr.phases[phase as usize];
+    if pr.flag(FLAG_CONDUCTIVITY_TABLE) && m.conductivity_points > 0 {
+        let law = &m.conductivity_law;
+        let tt = t.max(law[0].temperature[0]);
+        let mut k = 0usize;
+        for i in 1..m.conductivity_points as usize {
+            if tt >= law[i / 4].temperature[i % 4] {
+                k = i;
+            }
+        }
+        let (row, c) = (&law[k / 4], k % 4);
+        return row.value[c] + row.slope[c] * (tt - row.temperature[c]);
+    }
+    let ks = m.conductivity;
+    ks + fl * (m.liquid_conductivity - ks)
 }
 
 /// T and f_l from h; then the phase change of F22 §3.2 with a fixed substrate: a

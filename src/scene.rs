@@ -920,6 +920,10 @@ pub struct CheckDef {
     pub r18_slice_depth: Option<f64>,
     /// remelt: the reference remelt depth (m; F22 §4.3).
     pub depth: Option<f64>,
+    /// drop_contact: the first drop's share measured when the second touches
+    /// it, "solid" (default) or "liquid"; the tolerance bounds it from above.
+    #[serde(default)]
+    pub fraction: DropFraction,
     /// splat: the droplet's phase (default: every liquid phase), for scenes
     /// whose substrate is a liquid phase too (J22 §4.2).
     pub phase: Option<String>,
@@ -1017,6 +1021,18 @@ pub enum CheckKind {
     /// F22 §4.3: the deepest substrate remelt under a molten drop against a
     /// reference depth (`depth`).
     Remelt,
+    /// F22 §4.3, two and three drops: the share of the first drop that is
+    /// solid (or liquid: `fraction`) when the second first touches it.
+    DropContact,
+}
+
+/// `check.fraction` of `drop_contact`: which share of the first drop it measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DropFraction {
+    #[default]
+    Solid,
+    Liquid,
 }
 
 impl CheckKind {
@@ -1054,6 +1070,7 @@ impl CheckKind {
             CheckKind::R18Track => "r18_track",
             CheckKind::Splat => "splat",
             CheckKind::Remelt => "remelt",
+            CheckKind::DropContact => "drop_contact",
         }
     }
 }

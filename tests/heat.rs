@@ -640,7 +640,8 @@ fn enthalpy_table_with_latent_heat_melts_as_the_band_model() {
     let table =
         "enthalpy_table = [[500.0, 5.0e5], [599.5, 5.995e5], [600.5, 7.005e5], [800.0, 9.0e5]]\n";
     let mut out = String::new();
-    for line in text.lines() {
+    // Without the check: stefan_1d's reference takes constant properties.
+    for line in text[..text.find("[check]").unwrap()].lines() {
         let t = line.trim_start();
         if t.starts_with("heat_capacity") {
             out.push_str(table);

@@ -41,4 +41,43 @@ fn spread_scenes_validate_with_j22_spread_factors() {
             "{d0}: the check's reference is J22's {xi}"
         );
     }
+    // Two liquid phases: the splat check must be told which is the droplet.
+    let text = std::fs::read_to_string(common::scene_at("spray/j22_spread_30um_3d")).unwrap();
+    let head = &text[..text.find("[check]").unwrap()];
+    let without =
+        format!("{head}[check]\nkind = \"splat\"\nspread_factor = 2.0\ntolerance = 0.1\n");
+    assert!(without.len() < text.len());
+    let path = std::env::temp_dir().join("spread_without_check_phase.toml");
+    std::fs::write(&path, without).unwrap();
+    common::assert_input_error(&["validate", &path.to_string_lossy()], "check.phase");
+}
+
+/// F22 §4.3's two and three drops on a 500 K substrate (issue 31; run by hand,
+/// figures in the headers): each validates with its drops, and the
+/// drop_contact check's keys exit 2.
+#[test]
+fn drop_contact_scenes_validate() {
+    for (name, drops) in [("mjt/two_drops_3d", 2), ("mjt/three_drops_3d", 3)] {
+        let scene = common::scene_at(name);
+        let out = common::spatter(&["validate", &scene]);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(0), "{name}: {o}{e}");
+        assert!(!o.contains("warning"), "{name}: {o}");
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert_eq!(text.matches("phase = \"melt\"").count(), drops, "{name}");
+        common::assert_input_error(
+            &["validate", &scene, "--set", "check.fraction=\"gas\""],
+            "check.fraction",
+        );
+    }
+    // The check needs drops that melt.
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene("laplace_free_disc_2d"),
+            "--set",
+            "check.kind=\"drop_contact\"",
+        ],
+        "check.kind",
+    );
 }

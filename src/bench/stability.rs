@@ -117,6 +117,8 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("spray/j22_spread_62um_3d"), &[]),
     (scene_file!("mjt/drop_on_hot_substrate_3d"), &[]),
     (scene_file!("mjt/drop_on_cold_substrate_3d"), &[]),
+    (scene_file!("mjt/two_drops_3d"), &[]),
+    (scene_file!("mjt/three_drops_3d"), &[]),
 ];
 
 /// The long runs `--quick` keeps (one per kind of physics).

@@ -16,6 +16,7 @@
 mod bodies;
 mod compression;
 mod dam_break;
+mod drops;
 mod expansion;
 mod flow;
 mod heat;
@@ -173,6 +174,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
         CheckKind::Splat => Box::new(splat::Splat::new(m, c.phase.as_deref(), c.spread_factor)),
         CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
+        CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

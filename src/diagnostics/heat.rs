@@ -53,7 +53,8 @@ pub fn surface_loss_power(m: &Model, st: &State) -> (f64, f64) {
         let t = st.heat[i][1] as f64;
         let area = st.surface[i][3] as f64 * st.mass[i] as f64 / ph.rho0;
         if let Some(e) = th.evaporation {
-            evap += e.flux(t, th.heat_capacity) * area;
+            // The liquid's c_p, as the solver's loss (surface_loss in heat.wgsl).
+            evap += e.flux(t, th.liquid.1) * area;
         }
         rad += th.radiated_flux(t, m.ambient_temperature) * area;
     }

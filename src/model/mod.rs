@@ -634,6 +634,61 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 }
             }
         }
+        {
+            use crate::scene::CheckKind as K;
+            let constant_reference = matches!(
+                c.kind,
+                K::Conduction1d
+                    | K::ConductionTwoMaterials
+                    | K::Stefan1d
+                    | K::SolidificationFront
+                    | K::Rosenthal
+            );
+            // A table that varies: λ not constant, or h(T) not one straight line.
+            let tabled = phases.iter().any(|p| {
+                p.thermal.is_some_and(|t| {
+                    t.conductivity_table
+                        .is_some_and(|tb| tb.points().iter().any(|q| q.1 != tb.points[0].1))
+                        || t.enthalpy_table.is_some_and(|tb| {
+                            (1..tb.n - 1)
+                                .any(|k| (tb.slope(k) - tb.slope(0)).abs() > 1e-9 * tb.slope(0))
+                        })
+                })
+            });
+            if constant_reference && tabled {
+                return Err(cx.err(
+                    "check.kind",
+                    format!(
+                        "\"{}\"'s reference solution takes constant properties: not with a \
+                         varying enthalpy_table or conductivity_table",
+                        c.kind.name()
+                    ),
+                ));
+            }
+        }
+        if c.kind == crate::scene::CheckKind::Splat
+            && c.phase.is_none()
+            && phases
+                .iter()
+                .filter(|p| p.kind == PhaseKind::Liquid)
+                .count()
+                > 1
+        {
+            return Err(cx.err(
+                "check.phase",
+                "missing: \"splat\" in a scene with several liquid phases needs the droplet's",
+            ));
+        }
+        if c.kind == crate::scene::CheckKind::DropContact
+            && !phases.iter().any(|p| {
+                p.kind == PhaseKind::Liquid && p.thermal.is_some_and(|t| t.melting.is_some())
+            })
+        {
+            return Err(cx.err(
+                "check.kind",
+                "\"drop_contact\" needs liquid drops whose material melts (solidus, liquidus)",
+            ));
+        }
         if c.kind == crate::scene::CheckKind::Remelt {
             let d = c.depth.unwrap_or(f64::NAN);
             if !(d.is_finite() && d >= 0.0) {

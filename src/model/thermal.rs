@@ -138,12 +138,13 @@ pub(super) fn thermal_table(
                         format!("must exceed the solidus {ts} K (got {tl})"),
                     ));
                 }
-                // The latent heat is in the table; what the checks and
-                // diagnostics read as L is the band's enthalpy beyond the
-                // smallest slope's sensible heat.
+                // The latent heat is in the table; what the diagnostics read
+                // as L is the band's enthalpy beyond the sensible heat of the
+                // slope just below the solidus.
                 let t = enthalpy_table.as_ref().unwrap();
                 let band = t.extrapolated(tl) - t.extrapolated(ts);
-                Some((ts, tl, (band - heat_capacity * (tl - ts)).max(0.0)))
+                let below = (1..t.n).filter(|&i| ts > t.points[i].0).last().unwrap_or(0);
+                Some((ts, tl, (band - t.slope(below) * (tl - ts)).max(0.0)))
             }
             (Some(ts), Some(tl), Some(l)) => {
                 cx.positive(&mkey("solidus"), ts)?;
@@ -155,12 +156,14 @@ pub(super) fn thermal_table(
                 }
                 Some((ts, tl, cx.non_negative(&mkey("latent_heat"), l)?))
             }
-            _ => {
-                return Err(cx.err(
-                    &mkey("solidus"),
-                    "give solidus, liquidus and latent_heat together",
-                ))
-            }
+            _ => return Err(cx.err(
+                &mkey("solidus"),
+                if enthalpy_table.is_some() {
+                    "give solidus and liquidus together (the enthalpy_table holds the latent heat)"
+                } else {
+                    "give solidus, liquidus and latent_heat together"
+                },
+            )),
         };
         let evaporation = match &mat.evaporation {
             None => None,
@@ -212,7 +215,7 @@ pub(super) fn thermal_table(
                 },
                 match c {
                     Some(c) => cx.positive(&mkey("liquid_heat_capacity"), c)?,
-                    None => heat_capacity,
+                    None => enthalpy_table.map_or(heat_capacity, |t| t.slope(t.n - 1)),
                 },
             ),
         };

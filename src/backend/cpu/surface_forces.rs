@@ -328,7 +328,9 @@ pub fn tension_laplacian(pr: &Params, st: &mut State, grid: &CellTable) {
     let s: &State = st;
     let liquid = pr.tension.liquid;
     let eps = pr.kernel.h * pr.consts.tenth * pr.consts.tenth;
-    let out: Vec<Option<([f32; 3], f32)>> = (0..active)
+    // Per liquid particle: its acceleration (None below the threshold: the
+    // GPU twin adds nothing there, so −0.0 stays −0.0) and κ.
+    let out: Vec<Option<(Option<[f32; 3]>, f32)>> = (0..active)
         .into_par_iter()
         .map(|i| {
             if s.phase[i] != liquid {
@@ -353,18 +355,20 @@ pub fn tension_laplacian(pr: &Params, st: &mut State, grid: &CellTable) {
             });
             let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
             if gl <= pr.consts.tenth * pr.kernel.inv_h {
-                return Some(([0.0; 3], 0.0));
+                return Some((None, 0.0));
             }
             let kappa = -(lap / gl);
             let t_i = temperature(pr, s, i);
             let scale = pr.tension.alpha0 * ramp(pr, t_i) * kappa / s.rho[i];
-            Some(([scale * g[0], scale * g[1], scale * g[2]], kappa))
+            Some((Some([scale * g[0], scale * g[1], scale * g[2]]), kappa))
         })
         .collect();
     for (i, o) in out.into_iter().enumerate() {
         let Some((a, kappa)) = o else { continue };
-        for c in 0..3 {
-            st.acc[i][c] += a[c];
+        if let Some(a) = a {
+            for c in 0..3 {
+                st.acc[i][c] += a[c];
+            }
         }
         st.surface[n + i][S_CURVATURE] = kappa;
     }

@@ -114,10 +114,14 @@ impl Check for DropContact {
         for (t, s) in &self.history {
             details.push(format!("  {t:.4e} {s:.4}"));
         }
-        let (what, value) = match (self.touch, self.fraction) {
-            (None, _) => ("solid", f64::INFINITY),
-            (Some((_, s)), DropFraction::Solid) => ("solid", s),
-            (Some((_, s)), DropFraction::Liquid) => ("liquid", 1.0 - s),
+        let what = match self.fraction {
+            DropFraction::Solid => "solid",
+            DropFraction::Liquid => "liquid",
+        };
+        let value = match (self.touch, self.fraction) {
+            (None, _) => f64::INFINITY,
+            (Some((_, s)), DropFraction::Solid) => s,
+            (Some((_, s)), DropFraction::Liquid) => 1.0 - s,
         };
         details.push(match self.touch {
             Some((t, s)) => format!(

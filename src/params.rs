@@ -378,6 +378,33 @@ gpu_struct! {
     }
 }
 
+/// The segment of a piecewise-linear law (`n` points in two `LawPoints` rows)
+/// that `x` lies on: the last point k ≥ 1 whose `key` (its temperatures, or
+/// for the enthalpy's inverse its values) x reaches, else 0; as (row, component).
+/// The WGSL twins write the same loop inline (uniform arrays are not passed).
+#[inline(always)]
+pub fn law_segment(
+    law: &[LawPoints; 2],
+    n: u32,
+    x: f32,
+    key: impl Fn(&LawPoints) -> glam::Vec4,
+) -> (&LawPoints, usize) {
+    let mut k = 0usize;
+    for i in 1..n as usize {
+        if x >= key(&law[i / 4])[i % 4] {
+            k = i;
+        }
+    }
+    (&law[k / 4], k % 4)
+}
+
+/// y(t) on a law by temperature: value + slope (t − T) on t's segment.
+#[inline(always)]
+pub fn law_at(law: &[LawPoints; 2], n: u32, t: f32) -> f32 {
+    let (row, c) = law_segment(law, n, t, |r| r.temperature);
+    row.value[c] + row.slope[c] * (t - row.temperature[c])
+}
+
 gpu_struct! {
     /// Rigid bodies and their contact F22 (39)–(40) (FLAG_BODIES).
     pub struct Bodies {
@@ -783,15 +810,7 @@ impl Params {
         if p.flags & PHASE_DENSITY_LAW == 0 {
             return p.rho0;
         }
-        let mut k = 0usize;
-        for i in 1..p.density_points as usize {
-            if t >= p.density[i / 4].temperature[i % 4] {
-                k = i;
-            }
-        }
-        let row = &p.density[k / 4];
-        let c = k % 4;
-        row.value[c] + row.slope[c] * (t - row.temperature[c])
+        law_at(&p.density, p.density_points, t)
     }
     /// The phase's temperature follows its program, not the heat equation.
     pub fn programmed(&self, phase: u32) -> bool {

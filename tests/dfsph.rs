@@ -5,6 +5,12 @@
 
 mod common;
 
+/// The number that follows `label` in a line of a run's output.
+fn number_after(line: &str, label: &str) -> f64 {
+    let rest = line.split(label).nth(1).expect(line);
+    rest.split_whitespace().next().unwrap().parse().expect(line)
+}
+
 /// hydrostatic_dfsph_2d: p within 2% rms of ρ g (H − y) (the check's tolerance,
 /// J22's "pressure within 2%"), measured 0.51% at the scene's tolerances;
 /// each `/diagnostics` record carries the three solves' iterations and
@@ -28,15 +34,7 @@ fn hydrostatic_column_holds_its_pressure_within_2_percent() {
         .find(|l| l.starts_with("check hydrostatic"))
         .expect(&o);
     assert!(line.ends_with("PASS"), "{line}");
-    let value: f64 = line
-        .split(" = ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let value = number_after(line, " = ");
     assert!(value < 0.01, "{line}: measured 0.51% when this landed");
     let bytes = std::fs::read(&mcap).unwrap();
     let last: serde_json::Value = mcap::MessageStream::new(&bytes)
@@ -86,15 +84,7 @@ fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
         .find(|l| l.starts_with("check poiseuille"))
         .expect(&o);
     assert!(line.ends_with("PASS"), "{line}");
-    let value: f64 = line
-        .split(" = ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let value = number_after(line, " = ");
     assert!(value < 0.005, "{line}: measured 0.17% when this landed");
     let o = run(&["simulation.viscosity_form=\"marrone\""], 1);
     let line = o
@@ -121,15 +111,7 @@ fn spray_droplet_impact_matches_j22_timings() {
     let line = o.lines().find(|l| l.starts_with("check splat")).expect(&o);
     assert!(line.ends_with("PASS"), "{o}");
     let summary = o.lines().find(|l| l.contains("spread factor")).expect(&o);
-    let xi: f64 = summary
-        .split("spread factor ")
-        .nth(1)
-        .unwrap()
-        .split_whitespace()
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let xi = number_after(summary, "spread factor ");
     assert!(xi > 2.0, "{summary}: the splat must spread");
 }
 

@@ -81,41 +81,42 @@ pub(super) fn thermal_table(
                 None => Err(cx.err(&mkey(k), "missing: needed by a phase with a temperature")),
             }
         };
-        let enthalpy_table = match &mat.enthalpy_table {
-            None => None,
-            Some(points) => {
-                for (k, v) in [
-                    ("heat_capacity", mat.heat_capacity),
-                    ("liquid_heat_capacity", mat.liquid_heat_capacity),
-                    ("latent_heat", mat.latent_heat),
-                ] {
-                    if v.is_some() {
-                        return Err(cx.err(
-                            &mkey(k),
-                            "the enthalpy_table holds it: give one or the other",
-                        ));
-                    }
-                }
-                Some(law_table(cx, &mkey("enthalpy_table"), points, true)?)
+        // A table replaces the constants it tabulates: giving both is refused.
+        let table = |name: &str,
+                     points: &Option<Vec<Vec<f64>>>,
+                     replaced: &[(&str, Option<f64>)],
+                     rising: bool|
+         -> Result<Option<LawTable>, InputError> {
+            let Some(points) = points else {
+                return Ok(None);
+            };
+            if let Some((k, _)) = replaced.iter().find(|(_, v)| v.is_some()) {
+                return Err(cx.err(
+                    &mkey(k),
+                    format!("the {name} holds it: give one or the other"),
+                ));
             }
+            law_table(cx, &mkey(name), points, rising).map(Some)
         };
-        let conductivity_table = match &mat.conductivity_table {
-            None => None,
-            Some(points) => {
-                for (k, v) in [
-                    ("conductivity", mat.conductivity),
-                    ("liquid_conductivity", mat.liquid_conductivity),
-                ] {
-                    if v.is_some() {
-                        return Err(cx.err(
-                            &mkey(k),
-                            "the conductivity_table holds it: give one or the other",
-                        ));
-                    }
-                }
-                Some(law_table(cx, &mkey("conductivity_table"), points, false)?)
-            }
-        };
+        let enthalpy_table = table(
+            "enthalpy_table",
+            &mat.enthalpy_table,
+            &[
+                ("heat_capacity", mat.heat_capacity),
+                ("liquid_heat_capacity", mat.liquid_heat_capacity),
+                ("latent_heat", mat.latent_heat),
+            ],
+            true,
+        )?;
+        let conductivity_table = table(
+            "conductivity_table",
+            &mat.conductivity_table,
+            &[
+                ("conductivity", mat.conductivity),
+                ("liquid_conductivity", mat.liquid_conductivity),
+            ],
+            false,
+        )?;
         // With a table, the constants the time-step limit reads are its
         // extremes: the largest λ and the smallest dh/dT.
         let conductivity = match &conductivity_table {
@@ -128,32 +129,29 @@ pub(super) fn thermal_table(
                 .fold(f64::INFINITY, f64::min),
             None => need("heat_capacity", mat.heat_capacity)?,
         };
-        let melting = match (mat.solidus, mat.liquidus, mat.latent_heat) {
-            (None, None, None) => None,
-            (Some(ts), Some(tl), None) if enthalpy_table.is_some() => {
-                cx.positive(&mkey("solidus"), ts)?;
-                if !(tl > ts && tl.is_finite()) {
-                    return Err(cx.err(
-                        &mkey("liquidus"),
-                        format!("must exceed the solidus {ts} K (got {tl})"),
-                    ));
-                }
+        let band = |ts: f64, tl: f64| -> Result<(), InputError> {
+            cx.positive(&mkey("solidus"), ts)?;
+            if !(tl > ts && tl.is_finite()) {
+                return Err(cx.err(
+                    &mkey("liquidus"),
+                    format!("must exceed the solidus {ts} K (got {tl})"),
+                ));
+            }
+            Ok(())
+        };
+        let melting = match (mat.solidus, mat.liquidus, mat.latent_heat, &enthalpy_table) {
+            (None, None, None, _) => None,
+            (Some(ts), Some(tl), None, Some(t)) => {
+                band(ts, tl)?;
                 // The latent heat is in the table; what the diagnostics read
                 // as L is the band's enthalpy beyond the sensible heat of the
                 // slope just below the solidus.
-                let t = enthalpy_table.as_ref().unwrap();
-                let band = t.extrapolated(tl) - t.extrapolated(ts);
+                let rise = t.extrapolated(tl) - t.extrapolated(ts);
                 let below = (1..t.n).filter(|&i| ts > t.points[i].0).last().unwrap_or(0);
-                Some((ts, tl, (band - t.slope(below) * (tl - ts)).max(0.0)))
+                Some((ts, tl, (rise - t.slope(below) * (tl - ts)).max(0.0)))
             }
-            (Some(ts), Some(tl), Some(l)) => {
-                cx.positive(&mkey("solidus"), ts)?;
-                if !(tl > ts && tl.is_finite()) {
-                    return Err(cx.err(
-                        &mkey("liquidus"),
-                        format!("must exceed the solidus {ts} K (got {tl})"),
-                    ));
-                }
+            (Some(ts), Some(tl), Some(l), None) => {
+                band(ts, tl)?;
                 Some((ts, tl, cx.non_negative(&mkey("latent_heat"), l)?))
             }
             _ => return Err(cx.err(

@@ -27,8 +27,8 @@ use super::neighbors::{for_each_neighbor, CellTable};
 use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
-    Params, FLAG_BODIES, FLAG_CONDUCTIVITY_TABLE, FLAG_INTERFACE, FLAG_SOLIDIFICATION,
-    HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
+    law_at, law_segment, Params, FLAG_BODIES, FLAG_CONDUCTIVITY_TABLE, FLAG_INTERFACE,
+    FLAG_SOLIDIFICATION, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
 };
 use crate::portable_math::exp as pm_exp;
 use crate::state::{State, BODY_SOLIDIFIED};
@@ -355,14 +355,7 @@ pub fn temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
 #[inline(always)]
 fn table_temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     let m = pr.phase(phase);
-    let mut k = 0usize;
-    for i in 1..m.enthalpy_points as usize {
-        if h >= m.enthalpy[i / 4].value[i % 4] {
-            k = i;
-        }
-    }
-    let row = &m.enthalpy[k / 4];
-    let c = k % 4;
+    let (row, c) = law_segment(&m.enthalpy, m.enthalpy_points, h, |r| r.value);
     let t = row.temperature[c] + (h - row.value[c]) / row.slope[c];
     if m.flags & HEAT_MELTS != 0 {
         let fl = (t - m.solidus) / (m.liquidus - m.solidus);
@@ -380,14 +373,7 @@ pub fn conductivity(pr: &Params, phase: u32, t: f32, fl: f32) -> f32 {
     if pr.flag(FLAG_CONDUCTIVITY_TABLE) && m.conductivity_points > 0 {
         let law = &m.conductivity_law;
         let tt = t.max(law[0].temperature[0]);
-        let mut k = 0usize;
-        for i in 1..m.conductivity_points as usize {
-            if tt >= law[i / 4].temperature[i % 4] {
-                k = i;
-            }
-        }
-        let (row, c) = (&law[k / 4], k % 4);
-        return row.value[c] + row.slope[c] * (tt - row.temperature[c]);
+        return law_at(law, m.conductivity_points, tt);
     }
     let ks = m.conductivity;
     ks + fl * (m.liquid_conductivity - ks)

@@ -129,15 +129,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
             Some((Some(force(pr, n_i, t_i, kappa, gt, s.rho[i])), kappa))
         })
         .collect();
-    for (i, o) in out.into_iter().enumerate() {
-        let Some((a, kappa)) = o else { continue };
-        if let Some(a) = a {
-            for c in 0..3 {
-                st.acc[i][c] += a[c];
-            }
-        }
-        st.surface[n + i][S_CURVATURE] = kappa;
-    }
+    add_forces(st, n, out);
 }
 
 /// R18 (3.28)–(3.29), the free-surface form's raw curvature (first of its two
@@ -363,6 +355,12 @@ pub fn tension_laplacian(pr: &Params, st: &mut State, grid: &CellTable) {
             Some((Some([scale * g[0], scale * g[1], scale * g[2]]), kappa))
         })
         .collect();
+    add_forces(st, n, out);
+}
+
+/// Per particle of a tension dispatch: its acceleration added (none where
+/// the GPU twin adds nothing, so −0.0 stays −0.0) and its curvature stored.
+fn add_forces(st: &mut State, n: usize, out: Vec<Option<(Option<[f32; 3]>, f32)>>) {
     for (i, o) in out.into_iter().enumerate() {
         let Some((a, kappa)) = o else { continue };
         if let Some(a) = a {

@@ -228,23 +228,32 @@ pub fn assemble(m: &Model, st: &mut State, body_of: &[u32]) {
 /// when its centre is more than its own diameter above the bed's initial top
 /// (issue 17 item 6). None without a rigid bed.
 pub fn ejected_grains(m: &Model, st: &State) -> Option<(usize, usize)> {
+    let list = ejected_grain_list(m, st)?;
+    Some((list.iter().filter(|&&e| e).count(), list.len()))
+}
+
+/// Per grain of the rigid bed: is it ejected now (`ejected_grains`' rule)?
+pub fn ejected_grain_list(m: &Model, st: &State) -> Option<Vec<bool>> {
+    Some(grain_rise(m, st)?.iter().map(|&r| r > 1.0).collect())
+}
+
+/// Per grain of the rigid bed: how far its centre lies above the bed's initial
+/// top, in its diameters (NaN for one molten away or bonded into the substrate).
+pub fn grain_rise(m: &Model, st: &State) -> Option<Vec<f64>> {
     let bed = m.powder.as_ref().filter(|b| b.spec.rigid)?;
     let up = m.dim as usize - 1;
     let top = bed.spec.lo[up] + bed.thickness;
-    let mut ejected = 0;
+    let mut rise = vec![f64::NAN; bed.grains.len()];
     for (k, spec) in m.bodies.iter().enumerate() {
         let crate::model::BodySource::Grain(g) = spec.source else {
             continue;
         };
-        if !st.bodies[k].moves() {
-            continue; // molten away or bonded into the substrate
-        }
-        let height = m.to_world(st.bodies[k].x)[up];
-        if height > top + 2.0 * bed.grains[g].radius {
-            ejected += 1;
+        if st.bodies[k].moves() {
+            let height = m.to_world(st.bodies[k].x)[up];
+            rise[g] = (height - top) / (2.0 * bed.grains[g].radius);
         }
     }
-    Some((ejected, bed.grains.len()))
+    Some(rise)
 }
 
 /// What became of the rigid bodies (issue 17 item 6): bonded into the

@@ -816,11 +816,57 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),
         None => println!("time step: adaptive, initially {lim:.4e} s"),
     }
+    print_cost(m, st.len(), lim);
     let params = Params::new(m, st.len() as u32);
     let pipeline = Pipeline::for_scene(&params, st);
     println!("passes: {}", pipeline.pass_names().join(", "));
     println!("step: {}", pipeline.describe_step());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Measured throughputs (particle-steps/s) a scene's cost is projected from,
+/// docs/benchmarks.md: (one H100, 2 CPU cores of the CI machine kind). Plain
+/// WCSPH: the H100 at 1.6e7 particles (2026-11-23), this 2-core machine's CPU
+/// at 1e6 (dam_break_3d, issue 32). Heat and laser scenes: the H100 on
+/// line_melt_bare_plate (2.8e5 particles, 2026-11-23), the CPU on melt_block_3d.
+const PLAIN_RATES: (f64, f64) = (1.34e8, 1.7e6);
+const HEAT_RATES: (f64, f64) = (3.65e7, 4.3e5);
+
+/// `validate`'s cost line: steps at the initial time step, particle-steps, and
+/// the wall time they project to on one H100 and on 2 CPU cores.
+fn print_cost(m: &spatter::model::Model, particles: usize, dt0: f64) {
+    let steps = match m.end {
+        spatter::model::EndCondition::Steps(n) => n as f64,
+        spatter::model::EndCondition::Time(t) => (t / m.fixed_dt.unwrap_or(dt0)).ceil(),
+    };
+    let work = steps * particles as f64;
+    let heat = m.phases.iter().any(|p| p.conducts());
+    let ((gpu, cpu), which) = if heat {
+        (HEAT_RATES, "a laser heat scene's")
+    } else {
+        (PLAIN_RATES, "plain WCSPH's")
+    };
+    let hours = |rate: f64| {
+        let s = work / rate;
+        if s < 120.0 {
+            format!("{s:.0} s")
+        } else if s < 3600.0 {
+            format!("{:.1} min", s / 60.0)
+        } else {
+            format!("{:.1} h", s / 3600.0)
+        }
+    };
+    let adaptive = if m.fixed_dt.is_some() {
+        ""
+    } else {
+        " (the step adapts: more steps where the flow speeds up)"
+    };
+    println!(
+        "cost: about {steps:.3e} steps{adaptive}, {work:.3e} particle-steps; at {which} measured \
+         rates (docs/benchmarks.md) {} on one H100 ({gpu:.2e}/s), {} on 2 CPU cores ({cpu:.2e}/s)",
+        hours(gpu),
+        hours(cpu)
+    );
 }
 
 /// Hardware adapter: differences by tolerance (DESIGN.md), per field after one

@@ -1024,6 +1024,10 @@ pub enum CheckKind {
     /// F22 §4.3, two and three drops: the share of the first drop that is
     /// solid (or liquid: `fraction`) when the second first touches it.
     DropContact,
+    /// F22 §4.5, PBF point melting: peak temperature above T_v, a depression
+    /// deeper than a quarter of its width while the beam is on, an ejected
+    /// grain, an indentation below the plate's top after solidification.
+    PointMelt,
 }
 
 /// `check.fraction` of `drop_contact`: which share of the first drop it measures.
@@ -1071,6 +1075,7 @@ impl CheckKind {
             CheckKind::Splat => "splat",
             CheckKind::Remelt => "remelt",
             CheckKind::DropContact => "drop_contact",
+            CheckKind::PointMelt => "point_melt",
         }
     }
 }

@@ -330,7 +330,7 @@ impl Track {
 
 /// The top of the column that stands on the bottom: up from the lowest particle
 /// while each next one is within 1.5Δx.
-fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
+pub(crate) fn column_top(zs: &mut [f64], dx: f64) -> Option<f64> {
     zs.sort_by(|a, b| a.total_cmp(b));
     let last = *zs.last()?;
     Some(

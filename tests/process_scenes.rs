@@ -81,3 +81,73 @@ fn drop_contact_scenes_validate() {
         "check.kind",
     );
 }
+
+/// F22 §4.5's PBF point melting, the coarse 2D slice (20 s on 2 cores): every
+/// one of the four observables the issue names is met (peak temperature above
+/// T_v, a depression deeper than a quarter of its width while the beam is on,
+/// an ejected grain, the surface under the beam frozen below the plate's top),
+/// and the verdict, its figures and the per-sample series reach the MCAP's
+/// `/check` message. The full-size scene validates and states its cost.
+#[test]
+fn point_melt_coarse_meets_f22s_four_observables_and_writes_them() {
+    let scene = common::scene_at("pbf/point_melt_coarse_2d");
+    // 0.5: passes with no criterion missed (the value counts the missed ones).
+    common::assert_stated_tolerance(&scene, 0.5);
+    let dir = common::scratch("point_melt_coarse");
+    let mcap = dir.join("run.mcap");
+    let l = spatter::run::load(&scene, &[]).unwrap();
+    let mut out = common::mcap_outputs(&mcap, &l.model);
+    let r = common::run_with_outputs(&scene, &[], None, &mut out);
+    drop(out);
+    let c = r.check.expect("the scene has a check");
+    common::print_check("point_melt_coarse_2d", &[], &c);
+    assert!(c.pass, "{}", c.line());
+    assert!(common::figure(&c, "peak_temperature") > 3000.0);
+    assert!(common::figure(&c, "depression_aspect") > 0.25);
+    assert!(common::figure(&c, "ejected_grains") >= 1.0);
+    assert!(common::figure(&c, "indentation") > 2.5e-6);
+    let series = c.series.as_ref().expect("point_melt keeps its series");
+    assert_eq!(series.columns[0], "time");
+    assert!(
+        series.rows.len() >= 26,
+        "a row per frame: {}",
+        series.rows.len()
+    );
+    // The reader finds the same verdict in the stream.
+    let py = "import sys, json; sys.path.insert(0, 'tools'); import spatter_read as s; \
+              f, d, i = s.read_mcap(sys.argv[1]); c = i['check']; \
+              print(json.dumps([c['kind'], c['pass'], len(c['series']['rows'])]))";
+    let o = std::process::Command::new(common::python())
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["-c", py, mcap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let (so, se) = common::text(&o);
+    assert_eq!(
+        so.trim(),
+        format!("[\"point_melt\", true, {}]", series.rows.len()),
+        "{se}"
+    );
+
+    let full = common::scene_at("pbf/point_melt");
+    let out = common::spatter(&["validate", &full]);
+    let (o, e) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{o}{e}");
+    assert!(!o.contains("warning"), "{o}");
+    assert!(o.contains("powder: 500 grains"), "{o}");
+    assert!(
+        o.contains("cost: about") && o.contains("on one H100"),
+        "{o}"
+    );
+    // The check needs the beam's switch-off.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let always_on: String = text
+        .lines()
+        .filter(|l| !l.starts_with("power_until"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(always_on.len() < text.len());
+    let path = dir.join("always_on.toml");
+    std::fs::write(&path, always_on).unwrap();
+    common::assert_input_error(&["validate", &path.to_string_lossy()], "laser.power_until");
+}

@@ -102,7 +102,7 @@ def _messages(path):
 
 def read_mcap(path):
     frames, diagnostics, removed = [], [], []
-    info = {"schemas": {}, "metadata": {}, "track": None, "bodies": []}
+    info = {"schemas": {}, "metadata": {}, "track": None, "check": None, "bodies": []}
     batches = []
     for schema, channel, message, decoded in _messages(path):
         info["schemas"][channel.topic] = schema.name if schema else ""
@@ -114,6 +114,8 @@ def read_mcap(path):
             removed.append(decoded)
         elif channel.topic == "/track":
             info["track"] = decoded
+        elif channel.topic == "/check":
+            info["check"] = decoded
         elif channel.topic == "/bodies":
             info["bodies"].append(decoded)
         elif channel.topic == "/solidification":

@@ -110,6 +110,8 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=1e-5"],
     ),
     (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
+    (scene_file!("pbf/point_melt_coarse_2d"), &[]),
+    (scene_file!("pbf/point_melt"), &["dx=2e-5"]),
     (scene_file!("spray/j22_fluent_case_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_3d"), &[]),
     (scene_file!("spray/j22_spread_30um_3d"), &[]),

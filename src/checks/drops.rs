@@ -14,7 +14,7 @@
 //! 80 µm above the first) less than half of the first is solid; with two (160
 //! µm above) the first is almost completely solid.
 
-use super::{Check, Verdict};
+use super::{Check, Series, Verdict};
 use crate::model::Model;
 use crate::scene::{DropFraction, PhaseKind};
 use crate::state::{State, H_LIQUID};
@@ -104,6 +104,13 @@ impl Check for DropContact {
         if touches {
             self.touch = Some((t, share));
         }
+    }
+
+    fn series(&self) -> Option<Series> {
+        Some(Series {
+            columns: vec!["time", "drop1_solid_share"],
+            rows: self.history.iter().map(|&(t, s)| vec![t, s]).collect(),
+        })
     }
 
     fn verdict(&mut self, _m: &Model, _st: &State) -> Verdict {

@@ -11,7 +11,8 @@
 //! expansion.rs (δ-SPH thermal expansion: R18 Tests 1, 2 and 3), noise.rs (pressure
 //! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track), splat.rs
 //! (J22's droplet impact timings and splat size), remelt.rs (F22 §4.3: a
-//! drop's remelt of its substrate).
+//! drop's remelt of its substrate), drops.rs (F22 §4.3: drops on drops),
+//! point_melt.rs (F22 §4.5: PBF point melting's keyhole, ejections, indentation).
 
 mod bodies;
 mod compression;
@@ -21,6 +22,7 @@ mod expansion;
 mod flow;
 mod heat;
 mod noise;
+mod point_melt;
 mod remelt;
 mod solidification;
 mod splat;
@@ -46,9 +48,44 @@ pub struct CheckResult {
     /// Named secondary figures a check measures besides its verdict (e.g. the dam
     /// break's fitted release delay), for tests and scripts.
     pub figures: Vec<(String, f64)>,
+    /// The observables the check followed over the samples, where it keeps them.
+    pub series: Option<Series>,
+}
+
+/// A check's observables per sample: named columns, one row per sample (the
+/// first column is the time, s).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Series {
+    pub columns: Vec<&'static str>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+/// The `/check` message: the verdict, its figures and the series, written to
+/// the MCAP stream at the end of a completed run.
+#[derive(serde::Serialize)]
+pub struct CheckMessage<'a> {
+    pub kind: &'a str,
+    pub metric: &'a str,
+    pub value: f64,
+    pub tolerance: f64,
+    pub pass: bool,
+    pub figures: std::collections::BTreeMap<&'a str, f64>,
+    pub series: Option<&'a Series>,
 }
 
 impl CheckResult {
+    pub fn message(&self) -> CheckMessage<'_> {
+        CheckMessage {
+            kind: &self.name,
+            metric: &self.metric,
+            value: self.value,
+            tolerance: self.tolerance,
+            pass: self.pass,
+            figures: self.figures.iter().map(|(k, v)| (k.as_str(), *v)).collect(),
+            series: self.series.as_ref(),
+        }
+    }
+
     pub fn line(&self) -> String {
         format!(
             "check {}: {} = {:.4e} (tolerance {:.4e}) {}",
@@ -87,6 +124,10 @@ pub trait Check {
     fn observe(&mut self, _m: &Model, _st: &State) {}
     /// The verdict on the final state and the samples seen.
     fn verdict(&mut self, m: &Model, st: &State) -> Verdict;
+    /// The observables followed over the samples (for the `/check` message).
+    fn series(&self) -> Option<Series> {
+        None
+    }
 }
 
 /// The scene's check, watching the run: `observe` at every sample, `finish` at the end.
@@ -120,6 +161,7 @@ impl Checker {
             pass: v.value.is_finite() && v.value <= self.tolerance,
             details: v.details,
             figures: v.figures,
+            series: self.check.series(),
         }
     }
 }
@@ -175,6 +217,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Splat => Box::new(splat::Splat::new(m, c.phase.as_deref(), c.spread_factor)),
         CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
         CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
+        CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

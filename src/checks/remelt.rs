@@ -12,7 +12,7 @@
 //! F22 reports about 16 µm near 0.075 ms on a 1500 K substrate and no
 //! noticeable melting on a 500 K one (reference 0).
 
-use super::{Check, Verdict};
+use super::{Check, Series, Verdict};
 use crate::model::Model;
 use crate::scene::PhaseKind;
 use crate::state::State;
@@ -64,6 +64,13 @@ impl Check for Remelt {
             0.0
         };
         self.samples.push((st.sim.time as f64, depth));
+    }
+
+    fn series(&self) -> Option<Series> {
+        Some(Series {
+            columns: vec!["time", "remelt_depth"],
+            rows: self.samples.iter().map(|&(t, d)| vec![t, d]).collect(),
+        })
     }
 
     fn verdict(&mut self, m: &Model, _st: &State) -> Verdict {

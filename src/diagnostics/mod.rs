@@ -12,7 +12,7 @@ mod surface;
 
 pub use heat::{heat_diagnostics, set_pool, surface_loss_power, HeatDiagnostics};
 pub use leakage::Leakage;
-pub use schema::{bodies_schema, diagnostics_schema, removal_schema, track_schema};
+pub use schema::{bodies_schema, check_schema, diagnostics_schema, removal_schema, track_schema};
 pub use surface::{surface_diagnostics, SurfaceDiagnostics};
 
 use crate::model::Model;
@@ -25,11 +25,12 @@ pub const DIAGNOSTICS_TOPIC: &str = "/diagnostics";
 pub const REMOVED_TOPIC: &str = "/removed";
 pub const TRACK_TOPIC: &str = "/track";
 pub const BODIES_TOPIC: &str = "/bodies";
+pub const CHECK_TOPIC: &str = "/check";
 
 /// The JSON topics of a scene's MCAP stream, in channel order: `/diagnostics`
 /// and `/removed` always, `/track` in scenes with a melt track (crate::track),
 /// `/solidification` in scenes with a melting phase (crate::solidification),
-/// `/bodies` in scenes with rigid bodies.
+/// `/bodies` in scenes with rigid bodies, `/check` in scenes with a `[check]`.
 pub fn topics(m: &Model) -> Vec<JsonTopic> {
     let mut t = vec![
         JsonTopic {
@@ -62,6 +63,13 @@ pub fn topics(m: &Model) -> Vec<JsonTopic> {
             topic: BODIES_TOPIC,
             schema_name: "spatter.Bodies",
             schema: bodies_schema(),
+        });
+    }
+    if m.check.is_some() {
+        t.push(JsonTopic {
+            topic: CHECK_TOPIC,
+            schema_name: "spatter.Check",
+            schema: check_schema(),
         });
     }
     t

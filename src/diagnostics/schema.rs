@@ -191,6 +191,31 @@ pub fn removal_schema() -> serde_json::Value {
     })
 }
 
+/// JSON schema of the `/check` message (crate::checks::CheckMessage): the
+/// scene's check at the end of a completed run.
+pub fn check_schema() -> serde_json::Value {
+    serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "spatter.Check",
+        "type": "object",
+        "properties": {
+            "kind": {"type": "string", "description": "check.kind"},
+            "metric": {"type": "string", "description": "what the value measures"},
+            "value": {"type": "number"},
+            "tolerance": {"type": "number", "description": "the value passes at or below it"},
+            "pass": {"type": "boolean"},
+            "figures": {"type": "object", "additionalProperties": {"type": "number"},
+                        "description": "named figures the check measured besides its value (SI units)"},
+            "series": {"type": ["object", "null"], "description": "observables per sample",
+                       "properties": {
+                           "columns": {"type": "array", "items": {"type": "string"}},
+                           "rows": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}}
+                       }}
+        },
+        "required": ["kind", "metric", "value", "tolerance", "pass", "figures"]
+    })
+}
+
 /// JSON schema of the `/track` message (crate::track::TrackProfile).
 pub fn track_schema() -> serde_json::Value {
     let num = |desc: &str| serde_json::json!({"type": "number", "description": desc});

@@ -704,6 +704,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 return Err(cx.err("check.kind", "\"remelt\" needs a solid phase that melts"));
             }
         }
+        if c.kind == crate::scene::CheckKind::PointMelt {
+            point_melt_needs(&cx, scene, &phases)?;
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
@@ -1039,6 +1042,37 @@ fn barrier_def(
         stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
         damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
     }))
+}
+
+/// `point_melt` (F22 §4.5) reads the beam's switch-off, T_v and the plate's
+/// top: a laser whose power ends at 0 (`laser.power_until`), a material with
+/// `evaporation`, a solid phase that melts.
+fn point_melt_needs(cx: &Ctx, scene: &SceneFile, phases: &[PhaseInfo]) -> Result<(), InputError> {
+    if scene.laser.as_ref().and_then(|l| l.power_until).is_none() {
+        return Err(cx.err(
+            "laser.power_until",
+            "missing: \"point_melt\" judges the depression while the beam is on and the indentation after it goes off",
+        ));
+    }
+    if !phases
+        .iter()
+        .any(|p| p.thermal.is_some_and(|t| t.evaporation.is_some()))
+    {
+        return Err(cx.err(
+            "check.kind",
+            "\"point_melt\" needs a material with `evaporation` (its boiling_temperature is F22's T_v)",
+        ));
+    }
+    if !phases
+        .iter()
+        .any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some())
+    {
+        return Err(cx.err(
+            "check.kind",
+            "\"point_melt\" needs a solid phase that melts (the plate)",
+        ));
+    }
+    Ok(())
 }
 
 /// `check.kind = "thermocapillary"`: the channel the check's analytic solution

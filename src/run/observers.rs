@@ -4,7 +4,7 @@
 
 use super::{Outputs, RunEnd, RunOptions};
 use crate::checks::{CheckResult, Checker};
-use crate::diagnostics::{Diagnostics, Leakage, TRACK_TOPIC};
+use crate::diagnostics::{Diagnostics, Leakage, CHECK_TOPIC, TRACK_TOPIC};
 use crate::model::Model;
 use crate::solidification;
 use crate::state::State;
@@ -173,12 +173,16 @@ impl Observer for CheckObserver {
         m: &Model,
         last: &State,
         end: &RunEnd,
-        _out: &mut Outputs,
+        out: &mut Outputs,
         found: &mut Findings,
     ) -> Result<(), String> {
         // `Checker::finish` samples the final state itself.
         if *end == RunEnd::Completed {
-            found.check = Some(self.0.finish(m, last));
+            let result = self.0.finish(m, last);
+            if let Some(sink) = out.mcap.as_mut() {
+                sink.message(CHECK_TOPIC, last.sim.time as f64, &result.message())?;
+            }
+            found.check = Some(result);
         }
         Ok(())
     }

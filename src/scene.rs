@@ -931,6 +931,15 @@ pub struct CheckDef {
     /// verdict is the spread factor's relative departure from it, not J22's
     /// Fluent-case timings.
     pub spread_factor: Option<f64>,
+    /// deposition: the first grain's reference arrival at the substrate (s).
+    pub arrival: Option<f64>,
+    /// deposition: the reference pool diameter (m) at `diameter_time` (s),
+    /// within `diameter_tolerance` (relative, default 0.1).
+    pub diameter: Option<f64>,
+    pub diameter_time: Option<f64>,
+    pub diameter_tolerance: Option<f64>,
+    /// deposition: at least one grain must be left not fully molten.
+    pub unmolten: Option<bool>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -1028,6 +1037,9 @@ pub enum CheckKind {
     /// deeper than a quarter of its width while the beam is on, an ejected
     /// grain, an indentation below the plate's top after solidification.
     PointMelt,
+    /// F22 §4.4, directed energy deposition: the first grain's arrival, the
+    /// pool's diameter at a time, grains left not fully molten.
+    Deposition,
 }
 
 /// `check.fraction` of `drop_contact`: which share of the first drop it measures.
@@ -1076,6 +1088,7 @@ impl CheckKind {
             CheckKind::Remelt => "remelt",
             CheckKind::DropContact => "drop_contact",
             CheckKind::PointMelt => "point_melt",
+            CheckKind::Deposition => "deposition",
         }
     }
 }

@@ -151,3 +151,47 @@ fn point_melt_coarse_meets_f22s_four_observables_and_writes_them() {
     std::fs::write(&path, always_on).unwrap();
     common::assert_input_error(&["validate", &path.to_string_lossy()], "laser.power_until");
 }
+
+/// F22 §4.4's directed energy deposition (issue 31; 2 to 3 minutes each on 2
+/// cores, so run by hand: figures in the headers). Each coarse scene and the
+/// full-size one validate with their five grains, the full size states its
+/// cost, and the deposition check's keys exit 2.
+#[test]
+fn deposition_scenes_validate_and_their_check_keys_exit_2() {
+    for name in [
+        "ded/laser_on_coarse_3d",
+        "ded/laser_off_coarse_3d",
+        "ded/laser_on",
+    ] {
+        let scene = common::scene_at(name);
+        let out = common::spatter(&["validate", &scene]);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(0), "{name}: {o}{e}");
+        assert!(!o.contains("warning"), "{name}: {o}");
+        assert!(o.contains("cost: about"), "{name}: {o}");
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert_eq!(text.matches("body = true").count(), 5, "{name}");
+    }
+    let scene = common::scene_at("ded/laser_on_coarse_3d");
+    for (set, key) in [
+        ("check.arrival=-1.0", "check.arrival"),
+        ("check.diameter_tolerance=0.0", "check.diameter_tolerance"),
+        ("check.unmolten=\"yes\"", "check.unmolten"),
+    ] {
+        common::assert_input_error(&["validate", &scene, "--set", set], key);
+    }
+    // A diameter without the time to read it at.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let untimed: String = text
+        .lines()
+        .filter(|l| !l.starts_with("diameter_time"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let dir = common::scratch("deposition_keys");
+    let path = dir.join("untimed.toml");
+    std::fs::write(&path, untimed).unwrap();
+    common::assert_input_error(
+        &["validate", &path.to_string_lossy()],
+        "check.diameter_time",
+    );
+}

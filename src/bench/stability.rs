@@ -112,6 +112,9 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("pbf/powder_bed_line_melt"), &["dx=2e-5"]),
     (scene_file!("pbf/point_melt_coarse_2d"), &[]),
     (scene_file!("pbf/point_melt"), &["dx=2e-5"]),
+    (scene_file!("ded/laser_on_coarse_3d"), &[]),
+    (scene_file!("ded/laser_off_coarse_3d"), &[]),
+    (scene_file!("ded/laser_on"), &["dx=8e-6"]),
     (scene_file!("spray/j22_fluent_case_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_3d"), &[]),
     (scene_file!("spray/j22_spread_30um_3d"), &[]),
@@ -738,10 +741,10 @@ mod every_scene {
     use super::LONG_RUNS;
 
     /// "Long runs of every validation and process scene": each scene file under
-    /// scenarios/validation, pbf, spray and mjt has a LONG_RUNS row.
+    /// scenarios/validation, pbf, spray, mjt and ded has a LONG_RUNS row.
     #[test]
     fn every_validation_and_process_scene_has_a_long_run() {
-        for dir in ["validation", "pbf", "spray", "mjt"] {
+        for dir in ["validation", "pbf", "spray", "mjt", "ded"] {
             let path = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
             for entry in std::fs::read_dir(&path).unwrap() {
                 let name = entry.unwrap().file_name().into_string().unwrap();

@@ -12,11 +12,13 @@
 //! noise: R18 Test 4), track.rs (R18 §5.1.1's 2D powder-bed track), splat.rs
 //! (J22's droplet impact timings and splat size), remelt.rs (F22 §4.3: a
 //! drop's remelt of its substrate), drops.rs (F22 §4.3: drops on drops),
-//! point_melt.rs (F22 §4.5: PBF point melting's keyhole, ejections, indentation).
+//! point_melt.rs (F22 §4.5: PBF point melting's keyhole, ejections,
+//! indentation), deposition.rs (F22 §4.4: grains flying into a laser pool).
 
 mod bodies;
 mod compression;
 mod dam_break;
+mod deposition;
 mod drops;
 mod expansion;
 mod flow;
@@ -128,6 +130,11 @@ pub trait Check {
     fn series(&self) -> Option<Series> {
         None
     }
+    /// Sample at every diagnostics record too, not only at frames (events
+    /// closer together than the frames are).
+    fn every_sample(&self) -> bool {
+        false
+    }
 }
 
 /// The scene's check, watching the run: `observe` at every sample, `finish` at the end.
@@ -148,6 +155,11 @@ impl Checker {
 
     pub fn observe(&mut self, m: &Model, st: &State) {
         self.check.observe(m, st);
+    }
+
+    /// Does the check sample every diagnostics record (not only frames)?
+    pub fn every_sample(&self) -> bool {
+        self.check.every_sample()
     }
 
     pub fn finish(&mut self, m: &Model, st: &State) -> CheckResult {
@@ -218,6 +230,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
         CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
         CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),
+        CheckKind::Deposition => Box::new(deposition::Deposition::new(c)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -707,6 +707,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::PointMelt {
             point_melt_needs(&cx, scene, &phases)?;
         }
+        if c.kind == crate::scene::CheckKind::Deposition {
+            deposition_needs(&cx, scene, c)?;
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
@@ -1042,6 +1045,36 @@ fn barrier_def(
         stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
         damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
     }))
+}
+
+/// `deposition` (F22 §4.4) follows the scene's shape bodies (the grains) into a
+/// laser's pool; its references are positive, a diameter comes with its time,
+/// and it judges at least one thing.
+fn deposition_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
+    if scene.laser.is_none() || !scene.shapes.iter().any(|s| s.body) {
+        return Err(cx.err(
+            "check.kind",
+            "\"deposition\" needs a [laser] and grains as shapes with `body = true`",
+        ));
+    }
+    if let Some(t) = c.arrival {
+        cx.positive("check.arrival", t)?;
+    }
+    if let Some(d) = c.diameter {
+        cx.positive("check.diameter", d)?;
+        cx.positive("check.diameter_time", c.diameter_time.unwrap_or(f64::NAN))?;
+    }
+    if let Some(tol) = c.diameter_tolerance {
+        cx.positive("check.diameter_tolerance", tol)?;
+    }
+    if c.arrival.is_none() && c.diameter.is_none() && c.unmolten != Some(true) {
+        return Err(cx.err(
+            "check.kind",
+            "\"deposition\" needs something to judge: check.arrival, check.diameter (with \
+             check.diameter_time) or check.unmolten = true",
+        ));
+    }
+    Ok(())
 }
 
 /// `point_melt` (F22 §4.5) reads the beam's switch-off, T_v and the plate's

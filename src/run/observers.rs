@@ -164,7 +164,12 @@ struct CheckObserver(Checker);
 
 impl Observer for CheckObserver {
     fn observe(&mut self, m: &Model, st: &State, when: Moment) {
-        if matches!(when, Moment::Initial | Moment::Sample { frame: true }) {
+        let sampled = match when {
+            Moment::Initial => true,
+            Moment::Sample { frame } => frame || self.0.every_sample(),
+            _ => false,
+        };
+        if sampled {
             self.0.observe(m, st);
         }
     }

@@ -179,7 +179,7 @@ impl Layout {
     fn depression(&self, surface: &[f64], dx: f64) -> (f64, f64) {
         let depth = self.level - surface[self.beam_slice];
         let below = |k: usize| surface[k] < self.level - 0.5 * depth;
-        if !(depth > 0.5 * dx) {
+        if depth.is_nan() || depth <= 0.5 * dx {
             return (depth.max(0.0), 0.0);
         }
         let lo = (0..=self.beam_slice)

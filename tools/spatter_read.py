@@ -17,6 +17,12 @@ Commands:
     spatter_read.py track RUN.mcap OUT.png       laser track: remelt depth and surface height along x,
                                                  and a cross-section of the last frame (2D: the x-z
                                                  plane; 3D: y-z through the track's middle)
+    spatter_read.py section RUN.mcap OUT.png [--times T1,T2,...] [--field NAME] [--y Y]
+                                                 cross-sections of the frames nearest each time (default:
+                                                 the last) side by side: 2D as it is, 3D through the plane
+                                                 y = Y (default the middle), the particles within Δx/2 of
+                                                 it; coloured by temperature (default; phase without heat)
+                                                 or any frame channel (phase, liquid_fraction, ...) or speed
     spatter_read.py solidification RUN.mcap OUT.png [--cet A,N,N0]
                                                  solidification map: G against R of every liquidus
                                                  crossing (/solidification) with the columnar-to-
@@ -28,7 +34,9 @@ Commands:
 As a library: read_mcap(path) -> (frames, diagnostics, info); each frame is
 (time, {field: numpy array}) of the particles still in the simulation;
 info["removed"] lists the particles that left (id, phase, time, side, x, y, z,
-speed, mass); info["solidification"] the /solidification records as columns
+speed, mass); info["check"] the /check message (the scene's check at the end
+of a completed run: kind, metric, value, tolerance, pass, figures, series; None
+without); info["solidification"] the /solidification records as columns
 (t, x, y, z, gradient, solidification_rate, cooling_rate, ...: numpy arrays); info["track"] is the /track message of a laser scene (None
 without); info["bodies"] the /bodies messages of a scene with rigid bodies (one
 per frame: time, and per body its position, orientation, velocity, angular
@@ -304,6 +312,80 @@ def track(path, png):
     fig.savefig(png, dpi=100)
 
 
+def scenario_of(path):
+    """The resolved scenario TOML the run stored (a dict; {} without)."""
+    import tomllib
+    text = read_metadata(path).get("spatter", {}).get("scenario", "")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return {}
+
+
+def section(path, png, times=None, field=None, at=None):
+    """Cross-sections of frames as a row of panels: 2D scenes as they are (x-z),
+    3D scenes through the plane y = `at` (default: the middle of the particles'
+    y range), keeping the particles within half a particle spacing of it.
+    Coloured by `field` (default temperature, else phase): any frame channel,
+    or "speed". One panel per time (the frame nearest each; default the last)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    frames, _, _ = read_mcap(path)
+    if not frames:
+        raise SystemExit(f"{path}: no frames")
+    scene = scenario_of(path)
+    dx = scene.get("simulation", {}).get("dx")
+    if times is None:
+        picked = [frames[-1]]
+    else:
+        picked = [min(frames, key=lambda fr: abs(fr[0] - t)) for t in times]
+    names = list(scene.get("phases", {}).keys())
+    fig, axes = plt.subplots(1, len(picked), figsize=(4.2 * len(picked) + 1.2, 4.2), squeeze=False,
+                             sharey=True)
+    up = "z" if np.ptp(frames[0][1]["z"]) > 0 else "y"
+    xlim = (min(f["x"].min() for _, f in picked) * 1e6, max(f["x"].max() for _, f in picked) * 1e6)
+    ylim = (min(f[up].min() for _, f in picked) * 1e6, max(f[up].max() for _, f in picked) * 1e6)
+    for ax, (t, f) in zip(axes[0], picked):
+        three_d = np.ptp(f["z"]) > 0
+        key = field or ("temperature" if "temperature" in f else "phase")
+        if key == "speed":
+            values = np.sqrt(f["vx"] ** 2 + f["vy"] ** 2 + f["vz"] ** 2)
+        elif key in f:
+            values = f[key]
+        else:
+            raise SystemExit(f"{path}: no channel {key!r} (have: {', '.join(sorted(f))}, speed)")
+        if three_d:
+            y0 = at if at is not None else 0.5 * (f["y"].min() + f["y"].max())
+            half = 0.5 * (dx if dx else np.median(np.diff(np.unique(f["y"]))))
+            keep = np.abs(f["y"] - y0) <= half + 1e-12
+            h, v, c = f["x"][keep], f["z"][keep], values[keep]
+            where = f"y = {y0 * 1e6:.0f} µm"
+        else:
+            h, v, c = f["x"], f["y"], values
+            where = "x-y plane"
+        cmap = "tab10" if key == "phase" else "inferno"
+        vmin, vmax = (np.min(values), np.max(values)) if values.size else (0, 1)
+        if key == "phase":
+            vmin, vmax = -0.5, 9.5
+        sc = ax.scatter(h * 1e6, v * 1e6, c=c, s=4 if len(h) > 5000 else 8, cmap=cmap,
+                        vmin=vmin, vmax=vmax, linewidths=0)
+        ax.set_aspect("equal")
+        ax.set_xlim(xlim[0] - 5, xlim[1] + 5)
+        ax.set_ylim(ylim[0] - 5, ylim[1] + 5)
+        ax.set_xlabel("x (µm)")
+        ax.set_title(f"t = {t * 1e6:.1f} µs, {where}", fontsize=9)
+    axes[0][0].set_ylabel("up (µm)")
+    label = {"temperature": "temperature (K)", "speed": "speed (m/s)",
+             "liquid_fraction": "liquid fraction"}.get(key, key)
+    bar = fig.colorbar(sc, ax=axes[0].tolist(), label=label, shrink=0.85)
+    if key == "phase" and names:
+        bar.set_ticks(range(min(len(names), 10)))
+        bar.set_ticklabels(names[:10])
+    fig.suptitle(Path(path).name, fontsize=10)
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+
+
 # Gaumann, Bezencon, Canalis & Kurz, Acta Mater. 49 (2001) 1051, for CMSX-4:
 # the dendrite tip undercooling dT = (a V)^(1/n) and the heterogeneous
 # nucleation density N0. Hunt's limits of the equiaxed volume fraction phi:
@@ -401,6 +483,14 @@ def main(argv):
         if len(cet) != 3:
             raise SystemExit("--cet takes A,N,N0")
         solidification(path, argv[3], cet)
+    elif cmd == "section" and len(argv) >= 4:
+        opts = dict(zip(argv[4::2], argv[5::2]))
+        unknown = set(opts) - {"--times", "--field", "--y"}
+        if unknown or len(argv[4:]) % 2:
+            raise SystemExit("section takes --times T1,T2,... --field NAME --y Y (m)")
+        times = [float(v) for v in opts["--times"].split(",")] if "--times" in opts else None
+        section(path, argv[3], times, opts.get("--field"),
+                float(opts["--y"]) if "--y" in opts else None)
     elif cmd == "export-last" and len(argv) == 4:
         export_last(path, argv[3])
     elif cmd == "compare-vtk" and len(argv) == 4:

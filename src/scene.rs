@@ -940,6 +940,16 @@ pub struct CheckDef {
     pub diameter_tolerance: Option<f64>,
     /// deposition: at least one grain must be left not fully molten.
     pub unmolten: Option<bool>,
+    /// binder: the penetration (m) must end below this and the spread width
+    /// above that (a slower drop's figures: F22's order).
+    pub penetration_below: Option<f64>,
+    pub spread_above: Option<f64>,
+    /// binder: the binder must reach a side wall.
+    pub reaches_walls: Option<bool>,
+    /// binder: at least this many grains must be ejected.
+    pub ejected: Option<usize>,
+    /// binder: the binder must still move down at the end.
+    pub sinking: Option<bool>,
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -1040,6 +1050,9 @@ pub enum CheckKind {
     /// F22 §4.4, directed energy deposition: the first grain's arrival, the
     /// pool's diameter at a time, grains left not fully molten.
     Deposition,
+    /// F22 §4.2, binder jetting: the binder's penetration into the bed and
+    /// its spread against a slower drop's, binder at the walls, ejected grains.
+    Binder,
 }
 
 /// `check.fraction` of `drop_contact`: which share of the first drop it measures.
@@ -1089,6 +1102,7 @@ impl CheckKind {
             CheckKind::DropContact => "drop_contact",
             CheckKind::PointMelt => "point_melt",
             CheckKind::Deposition => "deposition",
+            CheckKind::Binder => "binder",
         }
     }
 }

@@ -115,6 +115,9 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("ded/laser_on_coarse_3d"), &[]),
     (scene_file!("ded/laser_off_coarse_3d"), &[]),
     (scene_file!("ded/laser_on"), &["dx=8e-6"]),
+    (scene_file!("bjt/binder_1ms_coarse_2d"), &[]),
+    (scene_file!("bjt/binder_10ms_coarse_2d"), &[]),
+    (scene_file!("bjt/binder_50ms_coarse_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_2d"), &[]),
     (scene_file!("spray/j22_fluent_case_3d"), &[]),
     (scene_file!("spray/j22_spread_30um_3d"), &[]),
@@ -741,10 +744,10 @@ mod every_scene {
     use super::LONG_RUNS;
 
     /// "Long runs of every validation and process scene": each scene file under
-    /// scenarios/validation, pbf, spray, mjt and ded has a LONG_RUNS row.
+    /// scenarios/validation, pbf, spray, mjt, ded and bjt has a LONG_RUNS row.
     #[test]
     fn every_validation_and_process_scene_has_a_long_run() {
-        for dir in ["validation", "pbf", "spray", "mjt", "ded"] {
+        for dir in ["validation", "pbf", "spray", "mjt", "ded", "bjt"] {
             let path = format!("{}/scenarios/{dir}", env!("CARGO_MANIFEST_DIR"));
             for entry in std::fs::read_dir(&path).unwrap() {
                 let name = entry.unwrap().file_name().into_string().unwrap();

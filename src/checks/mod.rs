@@ -13,8 +13,10 @@
 //! (J22's droplet impact timings and splat size), remelt.rs (F22 §4.3: a
 //! drop's remelt of its substrate), drops.rs (F22 §4.3: drops on drops),
 //! point_melt.rs (F22 §4.5: PBF point melting's keyhole, ejections,
-//! indentation), deposition.rs (F22 §4.4: grains flying into a laser pool).
+//! indentation), deposition.rs (F22 §4.4: grains flying into a laser pool),
+//! binder.rs (F22 §4.2: a binder drop into a powder bed).
 
+mod binder;
 mod bodies;
 mod compression;
 mod dam_break;
@@ -231,6 +233,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
         CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),
         CheckKind::Deposition => Box::new(deposition::Deposition::new(c)),
+        CheckKind::Binder => Box::new(binder::Binder::new(c)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -710,6 +710,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Deposition {
             deposition_needs(&cx, scene, c)?;
         }
+        if c.kind == crate::scene::CheckKind::Binder {
+            binder_needs(&cx, scene, c)?;
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
@@ -1045,6 +1048,42 @@ fn barrier_def(
         stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
         damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
     }))
+}
+
+/// `binder` (F22 §4.2) measures a liquid in a rigid powder bed and judges at
+/// least one thing; its lengths are positive.
+fn binder_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
+    if !scene.powder.as_ref().is_some_and(|p| p.rigid) {
+        return Err(cx.err(
+            "check.kind",
+            "\"binder\" needs a [powder] bed of rigid grains (`rigid = true`)",
+        ));
+    }
+    if let Some(p) = c.penetration_below {
+        cx.positive("check.penetration_below", p)?;
+    }
+    if let Some(w) = c.spread_above {
+        cx.positive("check.spread_above", w)?;
+    }
+    if c.ejected == Some(0) {
+        return Err(cx.err(
+            "check.ejected",
+            "at least 1 (0 grains ejected is no criterion)",
+        ));
+    }
+    if c.penetration_below.is_none()
+        && c.spread_above.is_none()
+        && c.reaches_walls != Some(true)
+        && c.ejected.is_none()
+        && c.sinking != Some(true)
+    {
+        return Err(cx.err(
+            "check.kind",
+            "\"binder\" needs something to judge: check.penetration_below, check.spread_above, \
+             check.reaches_walls = true, check.ejected or check.sinking = true",
+        ));
+    }
+    Ok(())
 }
 
 /// `deposition` (F22 §4.4) follows the scene's shape bodies (the grains) into a

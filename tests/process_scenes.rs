@@ -216,9 +216,9 @@ fn binder_scenes_validate_and_their_check_keys_exit_2() {
     // scene's header states.
     let one = std::fs::read_to_string(common::scene_at("bjt/binder_1ms_coarse_2d")).unwrap();
     let ten = std::fs::read_to_string(common::scene_at("bjt/binder_10ms_coarse_2d")).unwrap();
-    assert!(one.contains("18.0 um below the bed's top") && one.contains("spreads 78.1 um"));
-    assert!(ten.contains("penetration_below = 1.8016e-5"));
-    assert!(ten.contains("spread_above = 7.8125e-5"));
+    assert!(one.contains("1.1 um below the") && one.contains("spreads 72.2 um"));
+    assert!(ten.contains("penetration_below = 1.0561e-6"));
+    assert!(ten.contains("spread_above = 7.2244e-5"));
     let scene = common::scene_at("bjt/binder_50ms_coarse_2d");
     for (set, key) in [
         ("check.penetration_below=0.0", "check.penetration_below"),

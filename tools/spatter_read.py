@@ -382,8 +382,9 @@ def section(path, png, times=None, field=None, at=None):
     if key == "phase" and names:
         bar.set_ticks(range(min(len(names), 10)))
         bar.set_ticklabels(names[:10])
-    fig.suptitle(Path(path).name, fontsize=10)
-    fig.savefig(png, dpi=110, bbox_inches="tight")
+    source = read_metadata(path).get("spatter", {}).get("scenario_file") or path
+    fig.suptitle(Path(source).name, fontsize=10)
+    fig.savefig(png, dpi=90, bbox_inches="tight")
 
 
 # Gaumann, Bezencon, Canalis & Kurz, Acta Mater. 49 (2001) 1051, for CMSX-4:

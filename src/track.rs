@@ -104,7 +104,7 @@ pub struct TrackProfile {
     pub grains: Option<GrainMelting>,
 }
 
-fn condensed(m: &Model, st: &State, i: usize) -> bool {
+pub(crate) fn condensed(m: &Model, st: &State, i: usize) -> bool {
     let ph = &m.phases[st.phase[i] as usize];
     ph.conducts() && matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid)
 }

@@ -31,6 +31,7 @@ use super::{Check, Series, Verdict};
 use crate::model::Model;
 use crate::scene::PhaseKind;
 use crate::state::State;
+use crate::track::condensed;
 
 pub struct PointMelt {
     layout: Option<Layout>,
@@ -81,11 +82,6 @@ impl PointMelt {
             last_top: f64::NAN,
         }
     }
-}
-
-fn condensed(m: &Model, st: &State, i: usize) -> bool {
-    let ph = &m.phases[st.phase[i] as usize];
-    ph.conducts() && matches!(ph.kind, PhaseKind::Liquid | PhaseKind::Solid)
 }
 
 /// The time the beam goes off for good: the last power step, when it is 0.

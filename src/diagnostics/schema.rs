@@ -204,8 +204,8 @@ pub fn check_schema() -> serde_json::Value {
             "value": {"type": "number"},
             "tolerance": {"type": "number", "description": "the value passes at or below it"},
             "pass": {"type": "boolean"},
-            "figures": {"type": "object", "additionalProperties": {"type": "number"},
-                        "description": "named figures the check measured besides its value (SI units)"},
+            "figures": {"type": "object", "additionalProperties": {"type": ["number", "null"]},
+                        "description": "named figures the check measured besides its value (SI units; null: not measured)"},
             "series": {"type": ["object", "null"], "description": "observables per sample",
                        "properties": {
                            "columns": {"type": "array", "items": {"type": "string"}},

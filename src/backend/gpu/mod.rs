@@ -240,15 +240,30 @@ impl GpuBackend {
 
     /// The first `bytes` bytes of `src`, or why the device could not give them.
     fn read_bytes(&self, src: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>, DeviceLost> {
+        Ok(self.read_many(&[(src, bytes)])?.remove(0))
+    }
+
+    /// The first bytes of each buffer, all copied into one staging buffer by one
+    /// submission and mapped once: a whole state comes back in one round trip
+    /// instead of one per field (the bit-match compares the state after every
+    /// stage, so that round trip was most of its time on the software adapter).
+    fn read_many(&self, parts: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, DeviceLost> {
         let device = &self.ctx.device;
+        // Copies need 4-byte aligned offsets and sizes.
+        let padded = |b: u64| b.max(4).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT);
+        let total: u64 = parts.iter().map(|&(_, b)| padded(b)).sum();
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: bytes.max(4),
+            size: total.max(4),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let mut enc = device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(src, 0, &staging, 0, bytes.max(4));
+        let mut at = 0;
+        for &(src, bytes) in parts {
+            enc.copy_buffer_to_buffer(src, 0, &staging, at, padded(bytes));
+            at += padded(bytes);
+        }
         self.submit(enc);
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -262,12 +277,22 @@ impl GpuBackend {
             Ok(Err(e)) => return Err(DeviceLost(format!("GPU readback failed: {e}"))),
             Err(_) => return Err(DeviceLost("GPU readback never completed".into())),
         }
-        let out = staging
-            .get_mapped_range(..)
-            .map_err(|e| DeviceLost(format!("GPU readback could not be mapped: {e}")))?
-            .to_vec();
+        let out = {
+            let all = staging
+                .get_mapped_range(..)
+                .map_err(|e| DeviceLost(format!("GPU readback could not be mapped: {e}")))?;
+            let mut at = 0;
+            parts
+                .iter()
+                .map(|&(_, bytes)| {
+                    let part = all[at as usize..(at + bytes) as usize].to_vec();
+                    at += padded(bytes);
+                    part
+                })
+                .collect()
+        };
         staging.unmap();
-        Ok(out[..bytes as usize].to_vec())
+        Ok(out)
     }
 
     fn collect_profile(&mut self) {
@@ -346,20 +371,32 @@ impl Backend for GpuBackend {
     }
     /// Every field and table the scene holds (crate::fields), then the Sim block.
     fn read_state(&mut self) -> Result<State, DeviceLost> {
-        let mut st = State::default();
+        // Every held field and table and the Sim in one readback.
+        let mut parts: Vec<(&wgpu::Buffer, u64)> = Vec::new();
+        let mut fields = Vec::new();
         for (f, buf) in FIELDS.iter().zip(&self.buf.fields) {
             if self.held.holds(f.holder) {
-                let bytes = self.n as u64 * f.bytes_per_particle() as u64;
-                (f.set)(&mut st, &self.read_bytes(buf, bytes)?);
+                parts.push((buf, self.n as u64 * f.bytes_per_particle() as u64));
+                fields.push(f);
             }
         }
+        let mut tables = Vec::new();
         for ((t, buf), &entries) in TABLES.iter().zip(&self.buf.tables).zip(&self.table_entries) {
             if self.held.holds(t.holder) && entries > 0 {
-                let bytes = (entries * t.components * 4) as u64;
-                (t.set)(&mut st, &self.read_bytes(buf, bytes)?);
+                parts.push((buf, (entries * t.components * 4) as u64));
+                tables.push(t);
             }
         }
-        st.sim = self.read_sim()?;
+        parts.push((&self.buf.sim, std::mem::size_of::<Sim>() as u64));
+        let bytes = self.read_many(&parts)?;
+        let mut st = State::default();
+        for (f, b) in fields.iter().zip(&bytes) {
+            (f.set)(&mut st, b);
+        }
+        for (t, b) in tables.iter().zip(&bytes[fields.len()..]) {
+            (t.set)(&mut st, b);
+        }
+        st.sim = bytemuck::pod_read_unaligned(&bytes[bytes.len() - 1]);
         Ok(st)
     }
     fn load_state(&mut self, st: &State) {

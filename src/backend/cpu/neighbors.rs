@@ -316,16 +316,64 @@ impl Candidates {
         for v in [&mut self.dx, &mut self.dy, &mut self.dz, &mut self.r2] {
             v.resize(n, 0.0);
         }
-        self.hits.resize(n, 0);
+        // Room past n for the 8-lane stores of `compact` (8 by 8, then the tail).
+        self.hits.resize(n + 8, 0);
         self.hit_j.resize(n, 0);
-        self.hit_r2.resize(n, 0.0);
+        self.hit_r2.resize(n + 8, 0.0);
     }
 
     /// d = pi − r_j (minimum image) and r² for every candidate, then the in-order
     /// list of those with r² < support². The operations are `min_image`'s and
     /// `for_each_near`'s, so the bits are the same.
+    #[inline(always)]
     fn sweep(&mut self, pr: &Params, pos: &[[f32; 4]], grid: &CellTable, pi: [f32; 4]) {
         self.gather(pr, pos, grid, &pi);
+        #[cfg(target_arch = "x86_64")]
+        if *AVX2 {
+            // SAFETY: the CPU has AVX2 (checked once at run time).
+            return unsafe { self.distances_avx2(pr, pi) };
+        }
+        self.distances(pr, pi);
+    }
+
+    /// `distances` compiled for AVX2: the same IEEE operations (Rust never fuses
+    /// a multiply and an add), eight lanes at a time, and the compaction by
+    /// left-packing (`compact_avx2`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn distances_avx2(&mut self, pr: &Params, pi: [f32; 4]) {
+        self.differences(pr, pi);
+        let n = self.j.len();
+        // SAFETY: AVX2 is enabled here; hits and hit_r2 hold n + 8 entries.
+        self.count = unsafe {
+            compact_avx2(
+                &self.r2[..n],
+                pr.kernel.support2,
+                &mut self.hits,
+                &mut self.hit_r2,
+            )
+        };
+    }
+
+    fn distances(&mut self, pr: &Params, pi: [f32; 4]) {
+        self.differences(pr, pi);
+        let n = self.j.len();
+        let support2 = pr.kernel.support2;
+        // Branch-free compaction: every candidate is written at `count`, which
+        // advances only past a neighbour (count <= k, so it stays in bounds).
+        let (hits, hit_r2) = (&mut self.hits[..n], &mut self.hit_r2[..n]);
+        let mut count = 0;
+        for (k, &r2) in self.r2[..n].iter().enumerate() {
+            hits[count] = k as u32;
+            hit_r2[count] = r2;
+            count += (r2 < support2) as usize;
+        }
+        self.count = count;
+    }
+
+    /// d and r² of every candidate (vectorised by the compiler).
+    #[inline(always)]
+    fn differences(&mut self, pr: &Params, pi: [f32; 4]) {
         let n = self.j.len();
         let axes = [
             (&self.x[..n], &mut self.dx[..n]),
@@ -347,18 +395,84 @@ impl Candidates {
         for (k, r2) in self.r2[..n].iter_mut().enumerate() {
             *r2 = dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k];
         }
-        let support2 = pr.kernel.support2;
-        // Branch-free compaction: every candidate is written at `count`, which
-        // advances only past a neighbour (count <= k, so it stays in bounds).
-        let (hits, hit_r2) = (&mut self.hits[..n], &mut self.hit_r2[..n]);
-        let mut count = 0;
-        for (k, &r2) in self.r2[..n].iter().enumerate() {
-            hits[count] = k as u32;
-            hit_r2[count] = r2;
-            count += (r2 < support2) as usize;
-        }
-        self.count = count;
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+static AVX2: std::sync::LazyLock<bool> =
+    std::sync::LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
+
+/// For each 8-bit mask, the lanes whose bit is set, in order, then the rest:
+/// the permutation that packs a mask's lanes to the front.
+#[cfg(target_arch = "x86_64")]
+static LEFT_PACK: [[u32; 8]; 256] = {
+    let mut table = [[0u32; 8]; 256];
+    let mut m = 0;
+    while m < 256 {
+        let mut at = 0;
+        let mut lane = 0;
+        while lane < 8 {
+            if m & (1 << lane) != 0 {
+                table[m][at] = lane as u32;
+                at += 1;
+            }
+            lane += 1;
+        }
+        // The unset lanes fill the rest (their values are overwritten later).
+        let mut lane = 0;
+        while lane < 8 {
+            if m & (1 << lane) == 0 {
+                table[m][at] = lane as u32;
+                at += 1;
+            }
+            lane += 1;
+        }
+        m += 1;
+    }
+    table
+};
+
+/// The indices k and r²[k] of every r²[k] < support², in order, into `hits` and
+/// `hit_r2` (each at least r2.len() + 8 long); returns their count. Eight
+/// candidates at a time: one compare, a mask, and a permutation that packs the
+/// neighbours to the front, stored whole at `count` (the lanes past the
+/// neighbours are overwritten by the next store). Same selection as the scalar
+/// `r2 < support2` (false for NaN, as _CMP_LT_OQ).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn compact_avx2(r2: &[f32], support2: f32, hits: &mut [u32], hit_r2: &mut [f32]) -> usize {
+    use std::arch::x86_64::*;
+    let n = r2.len();
+    assert!(hits.len() >= n + 8 && hit_r2.len() >= n + 8);
+    let s2 = _mm256_set1_ps(support2);
+    let mut base = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let eight = _mm256_set1_epi32(8);
+    let mut count = 0;
+    let mut k = 0;
+    while k + 8 <= n {
+        // SAFETY: k + 8 <= n; count <= k, so count + 8 <= n + 8.
+        unsafe {
+            let v = _mm256_loadu_ps(r2.as_ptr().add(k));
+            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(v, s2)) as usize;
+            let perm = _mm256_loadu_si256(LEFT_PACK[mask].as_ptr() as *const __m256i);
+            let idx = _mm256_permutevar8x32_epi32(base, perm);
+            _mm256_storeu_si256(hits.as_mut_ptr().add(count) as *mut __m256i, idx);
+            _mm256_storeu_ps(
+                hit_r2.as_mut_ptr().add(count),
+                _mm256_permutevar8x32_ps(v, perm),
+            );
+            count += mask.count_ones() as usize;
+        }
+        base = _mm256_add_epi32(base, eight);
+        k += 8;
+    }
+    while k < n {
+        hits[count] = k as u32;
+        hit_r2[count] = r2[k];
+        count += (r2[k] < support2) as usize;
+        k += 1;
+    }
+    count
 }
 
 /// Visit every particle j within the support of point `pi`, in the same order as

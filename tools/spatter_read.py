@@ -346,15 +346,19 @@ def section(path, png, times=None, field=None, at=None):
     up = "z" if np.ptp(frames[0][1]["z"]) > 0 else "y"
     xlim = (min(f["x"].min() for _, f in picked) * 1e6, max(f["x"].max() for _, f in picked) * 1e6)
     ylim = (min(f[up].min() for _, f in picked) * 1e6, max(f[up].max() for _, f in picked) * 1e6)
-    for ax, (t, f) in zip(axes[0], picked):
-        three_d = np.ptp(f["z"]) > 0
+    def channel(f):
         key = field or ("temperature" if "temperature" in f else "phase")
         if key == "speed":
-            values = np.sqrt(f["vx"] ** 2 + f["vy"] ** 2 + f["vz"] ** 2)
-        elif key in f:
-            values = f[key]
-        else:
-            raise SystemExit(f"{path}: no channel {key!r} (have: {', '.join(sorted(f))}, speed)")
+            return key, np.sqrt(f["vx"] ** 2 + f["vy"] ** 2 + f["vz"] ** 2)
+        if key in f:
+            return key, f[key]
+        raise SystemExit(f"{path}: no channel {key!r} (have: {', '.join(sorted(f))}, speed)")
+
+    # One colour scale for every panel (the colour bar is drawn once).
+    every = np.concatenate([channel(f)[1] for _, f in picked])
+    for ax, (t, f) in zip(axes[0], picked):
+        three_d = np.ptp(f["z"]) > 0
+        key, values = channel(f)
         if three_d:
             y0 = at if at is not None else 0.5 * (f["y"].min() + f["y"].max())
             half = 0.5 * (dx if dx else np.median(np.diff(np.unique(f["y"]))))
@@ -365,7 +369,7 @@ def section(path, png, times=None, field=None, at=None):
             h, v, c = f["x"], f["y"], values
             where = "x-y plane"
         cmap = "tab10" if key == "phase" else "inferno"
-        vmin, vmax = (np.min(values), np.max(values)) if values.size else (0, 1)
+        vmin, vmax = (np.min(every), np.max(every)) if every.size else (0, 1)
         if key == "phase":
             vmin, vmax = -0.5, 9.5
         sc = ax.scatter(h * 1e6, v * 1e6, c=c, s=4 if len(h) > 5000 else 8, cmap=cmap,

@@ -128,6 +128,13 @@ pub fn with_neighbors<R>(
     f: impl FnOnce(&[u32], &[f32]) -> R,
 ) -> R {
     with_candidates(|near| {
+        #[cfg(target_arch = "x86_64")]
+        if *AVX2 && pr.sizes.flags & 7 == 0 {
+            near.gather(pr, pos, grid, &pos[i]);
+            // SAFETY: the CPU has AVX2 (checked once at run time).
+            let count = unsafe { near.neighbours_avx2(pr, pos[i]) };
+            return f(&near.hit_j[..count], &near.hit_r2[..count]);
+        }
         near.sweep(pr, pos, grid, pos[i]);
         let count = near.count;
         for k in 0..count {
@@ -318,7 +325,7 @@ impl Candidates {
         }
         // Room past n for the 8-lane stores of `compact` (8 by 8, then the tail).
         self.hits.resize(n + 8, 0);
-        self.hit_j.resize(n, 0);
+        self.hit_j.resize(n + 8, 0);
         self.hit_r2.resize(n + 8, 0.0);
     }
 
@@ -353,6 +360,65 @@ impl Candidates {
                 &mut self.hit_r2,
             )
         };
+    }
+
+    /// `with_neighbors` without periodic axes: j and r² of the candidates
+    /// inside the support straight into hit_j and hit_r2, eight at a time, r²
+    /// kept in registers (d is not stored: the callers want j and r² only).
+    /// The same operations as `differences` (pi − x, then dx² + dy² + dz² in
+    /// that order), so the same bits; returns the count.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn neighbours_avx2(&mut self, pr: &Params, pi: [f32; 4]) -> usize {
+        use std::arch::x86_64::*;
+        let n = self.j.len();
+        let (x, y, z, j) = (&self.x[..n], &self.y[..n], &self.z[..n], &self.j[..n]);
+        let (hit_j, hit_r2) = (&mut self.hit_j, &mut self.hit_r2);
+        assert!(hit_j.len() >= n + 8 && hit_r2.len() >= n + 8);
+        let support2 = pr.kernel.support2;
+        let s2 = _mm256_set1_ps(support2);
+        let (px, py, pz) = (
+            _mm256_set1_ps(pi[0]),
+            _mm256_set1_ps(pi[1]),
+            _mm256_set1_ps(pi[2]),
+        );
+        let mut count = 0;
+        let mut k = 0;
+        while k + 8 <= n {
+            // SAFETY: k + 8 <= n for the loads; count <= k, so the stores end
+            // by n + 8.
+            unsafe {
+                let dx = _mm256_sub_ps(px, _mm256_loadu_ps(x.as_ptr().add(k)));
+                let dy = _mm256_sub_ps(py, _mm256_loadu_ps(y.as_ptr().add(k)));
+                let dz = _mm256_sub_ps(pz, _mm256_loadu_ps(z.as_ptr().add(k)));
+                let r2 = _mm256_add_ps(
+                    _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                    _mm256_mul_ps(dz, dz),
+                );
+                let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(r2, s2)) as usize;
+                let perm = _mm256_loadu_si256(LEFT_PACK[mask].as_ptr() as *const __m256i);
+                let js = _mm256_loadu_si256(j.as_ptr().add(k) as *const __m256i);
+                _mm256_storeu_si256(
+                    hit_j.as_mut_ptr().add(count) as *mut __m256i,
+                    _mm256_permutevar8x32_epi32(js, perm),
+                );
+                _mm256_storeu_ps(
+                    hit_r2.as_mut_ptr().add(count),
+                    _mm256_permutevar8x32_ps(r2, perm),
+                );
+                count += mask.count_ones() as usize;
+            }
+            k += 8;
+        }
+        while k < n {
+            let d = [pi[0] - x[k], pi[1] - y[k], pi[2] - z[k]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            hit_j[count] = j[k];
+            hit_r2[count] = r2;
+            count += (r2 < support2) as usize;
+            k += 1;
+        }
+        count
     }
 
     fn distances(&mut self, pr: &Params, pi: [f32; 4]) {

@@ -80,7 +80,8 @@ pub struct BenchRow {
     pub dx: f64,
     pub steps: u32,
     pub wall_s: f64,
-    /// Fluid particles (the rest are walls, solids and gas-free bodies' members).
+    /// Particles of fluid phases (liquid or gas); the rest are walls and solids,
+    /// rigid bodies' members included.
     pub fluid_particles: usize,
     pub particle_steps_per_s: f64,
     pub pair_interactions_per_s: f64,
@@ -575,5 +576,65 @@ fn print_row(r: &BenchRow) {
             .map(|(n, ms)| format!("{n} {ms:.3}"))
             .collect();
         println!("    ms/step: {}", parts.join(", "));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(particles: usize, fluid: usize, pairs_per_fluid: f64, ns: f64) -> BenchRow {
+        let rate = 1e9 / ns;
+        BenchRow {
+            scene: "s".into(),
+            kind: "fluid-only".into(),
+            backend: "cpu".into(),
+            particles,
+            dx: 1.0,
+            steps: 1,
+            wall_s: 1.0,
+            fluid_particles: fluid,
+            particle_steps_per_s: rate,
+            pair_interactions_per_s: rate * fluid as f64 / particles as f64 * pairs_per_fluid,
+            neighbours_per_fluid_particle: pairs_per_fluid,
+            bytes_per_particle: 0.0,
+            pass_ms: vec![
+                ("density".into(), 1e-6 * ns * 0.4 * particles as f64),
+                ("forces".into(), 1e-6 * ns * 0.6 * particles as f64),
+            ],
+        }
+    }
+
+    /// Twice the cost per particle-step with five times the fluid share: the
+    /// growth line, and per fluid particle-step and per pair 60% cheaper.
+    #[test]
+    fn growth_separates_the_fluid_share_from_the_cost_per_pair() {
+        let (small, large) = (
+            row(1000, 100, 100.0, 100.0),
+            row(100_000, 50_000, 100.0, 200.0),
+        );
+        let lines = growth_lines("s", "cpu", &small, &large);
+        assert!(
+            lines[0].contains("100.0 ns at 1000 particles, 200.0 ns at 100000 (+100%)"),
+            "{}",
+            lines[0]
+        );
+        assert!(lines[1].contains("fluid share 10% -> 50%"), "{}", lines[1]);
+        assert!(
+            lines[1].contains("per fluid particle-step 1000.0 -> 400.0 ns (-60%)"),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[1].contains("per fluid pair 10.00 -> 4.00 ns (-60%)"),
+            "{}",
+            lines[1]
+        );
+        // forces grew by 60 ns per particle-step, density by 40.
+        assert!(
+            lines[2].contains("forces 60.0 -> 120.0 (+60.0), density 40.0 -> 80.0 (+40.0)"),
+            "{}",
+            lines[2]
+        );
     }
 }

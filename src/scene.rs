@@ -1037,6 +1037,9 @@ pub enum CheckKind {
     /// J22 §4.1: a droplet's impact, mean vertical velocity through zero and
     /// stop against J22's Fluent comparison; splat diameter and height.
     Splat,
+    /// A 3D droplet landing on a flat wall: the peak of the wall force (the
+    /// droplet's rate of change of momentum) against 0.8 ρV²D² (inertial regime).
+    ImpactForce,
     /// F22 §4.3: the deepest substrate remelt under a molten drop against a
     /// reference depth (`depth`).
     Remelt,
@@ -1098,6 +1101,7 @@ impl CheckKind {
             CheckKind::PressureNoise => "pressure_noise",
             CheckKind::R18Track => "r18_track",
             CheckKind::Splat => "splat",
+            CheckKind::ImpactForce => "impact_force",
             CheckKind::Remelt => "remelt",
             CheckKind::DropContact => "drop_contact",
             CheckKind::PointMelt => "point_melt",

@@ -36,8 +36,11 @@ impl Trip {
 
 /// Δt not finite, not positive or collapsed below the floor; or, when the scene's
 /// open sides stop the run, a particle has left (the scan then names it).
+/// A scene whose every limit is infinite at the start (DFSPH without gravity,
+/// heat or an explicit viscosity: its step follows the flow) has no floor.
 pub fn check_sim(m: &Model, sim: &Sim) -> Option<Trip> {
     let floor = m.watchdog.min_dt_ratio * m.limits.min().0;
+    let floor = if floor.is_finite() { floor } else { 0.0 };
     let dt = sim.dt as f64;
     if m.open_sides_policy == OpenSidesPolicy::Stop && sim.removed > 0 {
         return Some(Trip {

@@ -287,3 +287,51 @@ fn dfsph_keys_are_checked() {
         "{o}"
     );
 }
+
+/// The droplet impact of `bench accuracy` (scenarios/validation/drop_impact_3d,
+/// issue 30's "droplet impact at 1-50 m/s"): F22's steel, D = 50 µm at
+/// 50 m/s, on δ-SPH as written and on DFSPH. The wall force's peak (over
+/// 0.1 D/V) against the inertial-regime 0.8 ρV²D² within 10%, the scene's
+/// tolerance: the literature quotes the prefactor to a few percent, and the
+/// peak of a sampled particle force carries a few percent more (row pulses,
+/// acoustic ringing). Measured at the scene's D = 16 Δx: +3.8% (δ-SPH) and
+/// +8.7% (DFSPH); at 12, 20, 24 Δx the errors are 41, 11, 6.5% and 19, 2.4,
+/// 15% (docs/benchmarks.md): the peak is noisy in Δx, not converging. The
+/// force rises only after the contact less the kernel's reach.
+#[test]
+fn droplet_impact_force_within_10_percent_on_both_formulations() {
+    const TOLERANCE: f64 = 0.1;
+    common::assert_stated_tolerance(&common::scene("drop_impact_3d"), TOLERANCE);
+    for sets in [
+        &[][..],
+        &[
+            "simulation.formulation=\"dfsph\"",
+            "simulation.initial_pressure=\"zero\"",
+        ][..],
+    ] {
+        let c = common::run_check("drop_impact_3d", sets);
+        assert!(c.pass, "{sets:?}: {}", c.line());
+        let (peak, when) = (
+            common::figure(&c, "peak_force"),
+            common::figure(&c, "peak_time"),
+        );
+        assert!(when > 0.0 && when < 0.5, "{sets:?}: peak at t V/D = {when}");
+        assert!(common::figure(&c, "raw_peak_force") >= peak, "{sets:?}");
+        let d = common::figure(&c, "diameter");
+        assert!((d - 5.0e-5).abs() < 0.02 * 5.0e-5, "{sets:?}: D = {d}");
+    }
+}
+
+/// impact_force takes a 3D droplet (its reference is a sphere's).
+#[test]
+fn impact_force_check_refuses_a_2d_scene() {
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene_at("spray/j22_fluent_case_2d"),
+            "--set",
+            "check.kind=\"impact_force\"",
+        ],
+        "check.kind",
+    );
+}

@@ -25,6 +25,7 @@ mod drops;
 mod expansion;
 mod flow;
 mod heat;
+mod impact;
 mod noise;
 mod point_melt;
 mod remelt;
@@ -229,6 +230,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
         CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
         CheckKind::Splat => Box::new(splat::Splat::new(m, c.phase.as_deref(), c.spread_factor)),
+        CheckKind::ImpactForce => Box::new(impact::ImpactForce::new(m, c.phase.as_deref())),
         CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
         CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
         CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),

@@ -62,11 +62,7 @@ pub struct Splat {
 
 impl Splat {
     pub fn new(m: &Model, phase: Option<&str>, reference_spread: Option<f64>) -> Splat {
-        let droplet: Vec<bool> = m
-            .phases
-            .iter()
-            .map(|p| p.kind == PhaseKind::Liquid && phase.is_none_or(|name| p.name == name))
-            .collect();
+        let droplet = droplet_phases(m, phase);
         let first = m.phases.iter().zip(&droplet).find(|(_, &d)| d);
         Splat {
             samples: Vec::new(),
@@ -77,29 +73,6 @@ impl Splat {
             reference_spread,
             face: None,
         }
-    }
-
-    /// The substrate's top: the domain's lower face, or above it the highest
-    /// particle of a liquid or solid phase that is not the droplet's and lies
-    /// below the droplet's lowest particle (its upper side, Δx/2 above its
-    /// centre).
-    fn substrate_face(&self, m: &Model, st: &State) -> f64 {
-        let axis = m.dim as usize - 1;
-        let height = |i: usize| m.to_world(st.pos[i])[axis];
-        let droplet = |i: usize| self.droplet[st.phase[i] as usize];
-        let bottom = (0..st.active())
-            .filter(|&i| droplet(i))
-            .map(height)
-            .fold(f64::INFINITY, f64::min);
-        (0..st.active())
-            .filter(|&i| {
-                let p = &m.phases[st.phase[i] as usize];
-                !droplet(i)
-                    && matches!(p.kind, PhaseKind::Liquid | PhaseKind::Solid)
-                    && height(i) < bottom
-            })
-            .map(|i| height(i) + 0.5 * m.dx)
-            .fold(m.domain_lo[axis], f64::max)
     }
 
     fn sample(&self, m: &Model, st: &State, face: f64) -> Option<Sample> {
@@ -181,11 +154,42 @@ impl Splat {
     }
 }
 
+/// The substrate's top under a droplet (`droplet`: per phase): the domain's
+/// lower face, or above it the highest particle of a liquid or solid phase
+/// that is not the droplet's and lies below the droplet's lowest particle
+/// (its upper side, Δx/2 above its centre).
+pub(super) fn substrate_face(m: &Model, st: &State, droplet: &[bool]) -> f64 {
+    let axis = m.dim as usize - 1;
+    let height = |i: usize| m.to_world(st.pos[i])[axis];
+    let in_drop = |i: usize| droplet[st.phase[i] as usize];
+    let bottom = (0..st.active())
+        .filter(|&i| in_drop(i))
+        .map(height)
+        .fold(f64::INFINITY, f64::min);
+    (0..st.active())
+        .filter(|&i| {
+            let p = &m.phases[st.phase[i] as usize];
+            !in_drop(i)
+                && matches!(p.kind, PhaseKind::Liquid | PhaseKind::Solid)
+                && height(i) < bottom
+        })
+        .map(|i| height(i) + 0.5 * m.dx)
+        .fold(m.domain_lo[axis], f64::max)
+}
+
+/// Per phase: is it part of the droplet (`phase`, or every liquid phase)?
+pub(super) fn droplet_phases(m: &Model, phase: Option<&str>) -> Vec<bool> {
+    m.phases
+        .iter()
+        .map(|p| p.kind == PhaseKind::Liquid && phase.is_none_or(|name| p.name == name))
+        .collect()
+}
+
 impl Check for Splat {
     fn observe(&mut self, m: &Model, st: &State) {
         let face = match self.face {
             Some(f) => f,
-            None => *self.face.insert(self.substrate_face(m, st)),
+            None => *self.face.insert(substrate_face(m, st, &self.droplet)),
         };
         if let Some(s) = self.sample(m, st, face) {
             if self.samples.is_empty() {

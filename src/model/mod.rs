@@ -613,7 +613,17 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Thermocapillary {
             thermocapillary_layout(&cx, scene, dim, &phases, surface_tension.as_ref(), c)?;
         }
-        if c.kind == crate::scene::CheckKind::Splat {
+        let droplet_check = matches!(
+            c.kind,
+            crate::scene::CheckKind::Splat | crate::scene::CheckKind::ImpactForce
+        );
+        if c.kind == crate::scene::CheckKind::ImpactForce && dim != 3 {
+            return Err(cx.err(
+                "check.kind",
+                "\"impact_force\" needs a 3D scene (its reference, 0.8 rho V^2 D^2, is a sphere's)",
+            ));
+        }
+        if droplet_check {
             if let Some(name) = &c.phase {
                 if !phases
                     .iter()
@@ -666,7 +676,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 ));
             }
         }
-        if c.kind == crate::scene::CheckKind::Splat
+        if droplet_check
             && c.phase.is_none()
             && phases
                 .iter()
@@ -676,7 +686,10 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         {
             return Err(cx.err(
                 "check.phase",
-                "missing: \"splat\" in a scene with several liquid phases needs the droplet's",
+                format!(
+                    "missing: \"{}\" in a scene with several liquid phases needs the droplet's",
+                    c.kind.name()
+                ),
             ));
         }
         if c.kind == crate::scene::CheckKind::DropContact

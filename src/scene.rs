@@ -1224,15 +1224,53 @@ fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), I
     };
     let mut node = table;
     for seg in &path[..path.len() - 1] {
-        let entry = node
-            .entry(seg.clone())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        node = entry
-            .as_table_mut()
-            .ok_or_else(|| InputError::new(file, key, format!("--set: `{seg}` is not a table")))?;
+        node = match indexed(seg) {
+            Some((name, k)) => array_entry(file, key, node, name, k)?,
+            None => node
+                .entry(seg.clone())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+                .as_table_mut()
+                .ok_or_else(|| {
+                    InputError::new(file, key, format!("--set: `{seg}` is not a table"))
+                })?,
+        };
     }
     node.insert(path[path.len() - 1].clone(), value);
     Ok(())
+}
+
+/// `name[k]` in a `--set` path: an entry of an array of tables
+/// (`shapes[0].velocity=[0, 0, -10]`).
+fn indexed(seg: &str) -> Option<(&str, usize)> {
+    let (name, rest) = seg.split_once('[')?;
+    Some((name, rest.strip_suffix(']')?.trim().parse().ok()?))
+}
+
+/// Table `k` of the array of tables `name` in `node`; a missing array or an
+/// index past its end is an error naming the key.
+fn array_entry<'a>(
+    file: &str,
+    key: &str,
+    node: &'a mut toml::Table,
+    name: &str,
+    k: usize,
+) -> Result<&'a mut toml::Table, InputError> {
+    let err = |why: String| InputError::new(file, key, format!("--set: {why}"));
+    let array = node
+        .get_mut(name)
+        .and_then(|v| v.as_array_mut())
+        .ok_or_else(|| err(format!("the scene has no [[{name}]] entries")))?;
+    let n = array.len();
+    array
+        .get_mut(k)
+        .ok_or_else(|| {
+            let entries = if n == 1 { "entry" } else { "entries" };
+            err(format!(
+                "index {k} is past the {n} [[{name}]] {entries} (indices from 0)"
+            ))
+        })?
+        .as_table_mut()
+        .ok_or_else(|| err(format!("`{name}[{k}]` is not a table")))
 }
 
 const RUN_KEYS: [&str; 6] = [

@@ -44,6 +44,9 @@ fn bad_overrides_exit_2() {
         ("dx=-1", "simulation.dx"),
         ("materials.fluid.density=0", "materials.fluid.density"),
         ("noequals", "noequals"),
+        // An array-of-tables entry that is not there, or no such array.
+        ("shapes[7].velocity=[0.0,0.0]", "shapes[7].velocity"),
+        ("powder[0].seed=2", "powder[0].seed"),
     ] {
         let out = spatter(&["validate", &scene, "--set", set]);
         let (_, stderr) = text(&out);

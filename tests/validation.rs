@@ -310,6 +310,22 @@ fn set_override_changes_resolution() {
     assert_eq!(fluid(&coarse) * 4, fluid(&fine));
 }
 
+/// `--set shapes[k].key=value` reaches into the k-th `[[shapes]]` entry (a
+/// droplet's speed, for a sweep over impact speeds).
+#[test]
+fn set_override_reaches_an_array_of_tables_entry() {
+    let scene = common::scene("drop_impact_3d");
+    let slow = load(&scene, &["shapes[0].velocity=[0.0, 0.0, -10.0]".into()]).unwrap();
+    let fast = load(&scene, &[]).unwrap();
+    let vz = |l: &spatter::run::Loaded| {
+        let i = (0..l.state.len())
+            .find(|&i| l.model.phases[l.state.phase[i] as usize].is_fluid())
+            .unwrap();
+        l.state.vel[i][2]
+    };
+    assert_eq!((vz(&slow), vz(&fast)), (-10.0, -50.0));
+}
+
 /// The GPU path runs a whole scene to the same verdict, and `--profile` reports
 /// per-pass milliseconds from timestamp queries.
 #[test]

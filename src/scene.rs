@@ -1222,6 +1222,19 @@ fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), I
             }
         }
     };
+    for (k, seg) in path.iter().enumerate() {
+        let bracket = seg.contains(['[', ']']);
+        if bracket && (indexed(seg).is_none() || k + 1 == path.len()) {
+            return Err(InputError::new(
+                file,
+                key,
+                format!(
+                    "--set: `{seg}`: an array-of-tables entry is written name[k] with k a whole \
+                     number from 0, followed by a key (shapes[0].velocity=[0.0, 0.0, -1.0])"
+                ),
+            ));
+        }
+    }
     let mut node = table;
     for seg in &path[..path.len() - 1] {
         node = match indexed(seg) {
@@ -1243,7 +1256,10 @@ fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), I
 /// (`shapes[0].velocity=[0, 0, -10]`).
 fn indexed(seg: &str) -> Option<(&str, usize)> {
     let (name, rest) = seg.split_once('[')?;
-    Some((name, rest.strip_suffix(']')?.trim().parse().ok()?))
+    let k = rest.strip_suffix(']')?.trim();
+    (!name.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+        .then(|| Some((name, k.parse().ok()?)))
+        .flatten()
 }
 
 /// Table `k` of the array of tables `name` in `node`; a missing array or an

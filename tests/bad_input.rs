@@ -47,6 +47,11 @@ fn bad_overrides_exit_2() {
         // An array-of-tables entry that is not there, or no such array.
         ("shapes[7].velocity=[0.0,0.0]", "shapes[7].velocity"),
         ("powder[0].seed=2", "powder[0].seed"),
+        // Malformed indices, and an index with no key after it.
+        ("shapes[-1].velocity=[0.0,0.0]", "shapes[-1].velocity"),
+        ("shapes[].velocity=[0.0,0.0]", "shapes[].velocity"),
+        ("shapes[0]x.velocity=[0.0,0.0]", "shapes[0]x.velocity"),
+        ("shapes[0]=1", "shapes[0]"),
     ] {
         let out = spatter(&["validate", &scene, "--set", set]);
         let (_, stderr) = text(&out);

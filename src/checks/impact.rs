@@ -148,12 +148,12 @@ impl ImpactForce {
             .collect()
     }
 
-    /// The sampling interval (the smallest gap between samples).
+    /// The sampling interval: the median gap between samples (the last one,
+    /// at the end of the run, and a frame's can fall closer).
     fn interval(&self) -> f64 {
-        self.samples
-            .windows(2)
-            .map(|w| w[1].t - w[0].t)
-            .fold(f64::INFINITY, f64::min)
+        let mut gaps: Vec<f64> = self.samples.windows(2).map(|w| w[1].t - w[0].t).collect();
+        gaps.sort_by(f64::total_cmp);
+        gaps.get(gaps.len() / 2).copied().unwrap_or(f64::INFINITY)
     }
 
     /// ρ0 of the droplet's (first) phase, the speed at the contact and the diameter.

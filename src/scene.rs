@@ -1257,9 +1257,11 @@ fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), I
 fn indexed(seg: &str) -> Option<(&str, usize)> {
     let (name, rest) = seg.split_once('[')?;
     let k = rest.strip_suffix(']')?.trim();
-    (!name.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
-        .then(|| Some((name, k.parse().ok()?)))
-        .flatten()
+    // Digits only: usize's parser would take "+1".
+    if name.is_empty() || !k.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some((name, k.parse().ok()?))
 }
 
 /// Table `k` of the array of tables `name` in `node`; a missing array or an

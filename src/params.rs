@@ -508,6 +508,12 @@ gpu_struct! {
         pub sin_c2: f32,
         pub sin_c3: f32,
         pub sin_c4: f32,
+        /// The timestep pass counts the end time as reached when less than this
+        /// fraction of it remains (f32 time's rounding, a few ulps).
+        pub end_slack: f32,
+        /// model::limits::END_STEPS and END_STRETCH: the approach to the end.
+        pub end_steps: f32,
+        pub end_stretch: f32,
     }
 }
 
@@ -581,6 +587,9 @@ pub const SHADER_CONSTS: Consts = {
         sin_c2: pm::SIN_C[2],
         sin_c3: pm::SIN_C[3],
         sin_c4: pm::SIN_C[4],
+        end_slack: crate::model::limits::END_SLACK,
+        end_steps: crate::model::limits::END_STEPS,
+        end_stretch: crate::model::limits::END_STRETCH,
     }
 };
 

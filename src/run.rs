@@ -255,8 +255,80 @@ impl Outputs {
 /// Steps between host reads of Δt and time: about 2e6 particle-updates, at most
 /// 200 steps. It depends on the particle count only, so chunking (and with it the
 /// step a time-ended run stops at) is the same on every run and after a resume.
+/// Tell the timestep pass the run's end time (0 for a run of so many steps), so
+/// its last steps land on it, and shorten the step already computed (by the
+/// prime or before a checkpoint) where it would cross it.
+fn land_on_end(backend: &mut dyn Backend, sim: &mut crate::state::Sim, end: EndCondition) {
+    sim.end_time = match end {
+        EndCondition::Time(te) => te as f32,
+        EndCondition::Steps(_) => 0.0,
+    };
+    if let Some(dt) = crate::model::limits::toward_end(sim.end_time, sim.time, sim.dt) {
+        sim.dt = dt;
+        sim.dt_limit = crate::model::limits::Limit::End.code();
+    }
+    backend.write_sim(sim);
+}
+
+/// Whether the end time is reached: within END_SLACK of it, as the timestep
+/// pass counts it (f32 time).
+fn end_reached(end: f64, time: f32) -> bool {
+    let end = end as f32;
+    end - time <= crate::model::limits::END_SLACK * end
+}
+
+/// How many steps to run before reading back, `left` seconds before the next
+/// output or the end: the fewest steps of the longest possible length that
+/// cover it. Every step before the last of them ends short of the target, so a
+/// chunk never runs past the step that lands on the end (the steps after it
+/// would go on past). An estimate from the current Δt overshot by up to a
+/// third of the run when Δt grew inside a chunk (a DFSPH splat slowing down).
+/// Single steps where nothing bounds Δt; no bound where nothing is due (a run
+/// of so many steps without outputs).
+fn steps_toward(left: f64, longest: f64) -> u64 {
+    if left == f64::INFINITY {
+        return u64::MAX;
+    }
+    let covering = (left / longest).ceil();
+    if covering.is_finite() && covering > 1.0 {
+        covering as u64
+    } else {
+        1
+    }
+}
+
 fn chunk_cap(particles: usize) -> u64 {
     (2_000_000 / particles.max(1) as u64).clamp(1, 200)
+}
+
+/// The longest step the timestep pass can take (f32, as it computes): the
+/// fixed Δt, or the smallest of the constant limits and the acoustic one at
+/// rest (|u| only shortens it; the force limit is left out, since the flow's
+/// accelerations can fall below gravity's). ∞ when nothing bounds it (DFSPH
+/// without `run.max_dt` and without other limits).
+fn longest_step(ts: &crate::params::TimeStep, h: f32) -> f64 {
+    if ts.fixed_dt > 0.0 {
+        return ts.fixed_dt as f64;
+    }
+    let mut dt = f32::MAX;
+    if ts.max_sound_speed > 0.0 {
+        dt = 0.25 * h / ts.max_sound_speed;
+    }
+    for lim in [
+        ts.viscous_limit,
+        ts.conduction_limit,
+        ts.barrier_limit,
+        ts.capillary_limit,
+        ts.contact_limit,
+        ts.maximum_limit,
+    ] {
+        dt = dt.min(lim);
+    }
+    if dt == f32::MAX {
+        f64::INFINITY
+    } else {
+        dt as f64
+    }
 }
 
 /// The first multiple of `interval` after `t` (∞ for an infinite interval).
@@ -367,6 +439,7 @@ pub fn run(
     let mut st = backend
         .read_state()
         .map_err(|e| device_lost(m, out, &l.state, e))?;
+    land_on_end(backend, &mut st.sim, opts.end);
     let mut last_good = st.clone();
     let mut sim = st.sim;
     let start_step = sim.step as u64;
@@ -375,15 +448,19 @@ pub fn run(
     out.frame(m, &st).map_err(rt)?;
     out.diagnostics(m, &st, &observers).map_err(rt)?;
     let cap = chunk_cap(st.len());
+    // The approach to the end may stretch a step by END_STRETCH.
+    let longest = longest_step(&Params::new(m, st.len() as u32).time_step, m.h as f32)
+        * crate::model::limits::END_STRETCH as f64;
     let mut steps_done = 0u64;
-    let mut trip = watchdog::check_sim(m, &sim).or_else(|| watchdog::scan(m, &st));
+    let start_dt = sim.dt;
+    let mut trip = watchdog::check_sim(m, &sim, start_dt).or_else(|| watchdog::scan(m, &st));
     let mut end = RunEnd::Completed;
     let mut stop_reason = None;
     while trip.is_none() {
         let t = sim.time as f64;
         let (done, frac) = match opts.end {
             EndCondition::Steps(n) => (steps_done >= n, steps_done as f64 / n.max(1) as f64),
-            EndCondition::Time(te) => (t >= te, t / te),
+            EndCondition::Time(te) => (end_reached(te, sim.time), t / te),
         };
         if done {
             break;
@@ -396,7 +473,7 @@ pub fn run(
             EndCondition::Time(te) => sched.next().min(te),
             EndCondition::Steps(_) => sched.next(),
         };
-        let mut chunk = (((target - t) / sim.dt as f64).ceil().max(1.0)) as u64;
+        let mut chunk = steps_toward(target - t, longest);
         if let EndCondition::Steps(n) = opts.end {
             chunk = chunk.min(n - steps_done);
         }
@@ -414,7 +491,7 @@ pub fn run(
             sim.dt_limit,
             rate,
         );
-        trip = watchdog::check_sim(m, &sim);
+        trip = watchdog::check_sim(m, &sim, start_dt);
         let t = sim.time as f64;
         let eps = 1e-12;
         let due = (
@@ -462,7 +539,7 @@ pub fn run(
     }
     let final_state = match trip {
         Some(first) => {
-            let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first)
+            let (precise, bad, good) = replay_to_trip(m, backend, &last_good, first, start_dt)
                 .map_err(|e| device_lost(m, out, &last_good, e))?;
             observe_all(&mut observers, m, &bad, Moment::Unstable);
             out.frame(m, &bad).map_err(rt)?;
@@ -556,6 +633,7 @@ fn replay_to_trip(
     backend: &mut dyn Backend,
     last_good: &State,
     first: Trip,
+    start_dt: f32,
 ) -> Result<(Trip, State, State), DeviceLost> {
     let span = (first.step.saturating_sub(last_good.sim.step as u64) + 1) * 2;
     backend.load_state(last_good);
@@ -564,7 +642,9 @@ fn replay_to_trip(
         backend.run_steps(1);
         let st = backend.read_state()?;
         // The scan first: it names the particle where check_sim only counts.
-        if let Some(t) = watchdog::scan(m, &st).or_else(|| watchdog::check_sim(m, &st.sim)) {
+        if let Some(t) =
+            watchdog::scan(m, &st).or_else(|| watchdog::check_sim(m, &st.sim, start_dt))
+        {
             return Ok((t, st, good));
         }
         good = st;
@@ -642,6 +722,26 @@ mod tests {
             self.read()?;
             self.inner.read_sim()
         }
+        fn write_sim(&mut self, sim: &crate::state::Sim) {
+            self.inner.write_sim(sim)
+        }
+    }
+
+    /// A chunk is the fewest steps of the longest possible length that cover the
+    /// time left, so all but its last end short of the target; single steps
+    /// where nothing bounds Δt; unbounded where nothing is due.
+    #[test]
+    fn chunks_never_reach_past_the_end() {
+        assert_eq!(steps_toward(10.0, 1.0), 10);
+        assert_eq!(steps_toward(10.5, 1.0), 11);
+        assert_eq!(steps_toward(0.1, 1.0), 1);
+        assert_eq!(steps_toward(10.0, f64::INFINITY), 1);
+        assert_eq!(steps_toward(f64::INFINITY, 1.0), u64::MAX);
+        assert_eq!(steps_toward(f64::INFINITY, f64::INFINITY), u64::MAX);
+        for left in [3.3, 7.0, 12.9] {
+            let k = steps_toward(left, 1.0) as f64;
+            assert!(k - 1.0 < left && k >= left, "{k} steps of 1 for {left}");
+        }
     }
 
     /// A device lost mid-run ends it with an error naming the step it stopped at,
@@ -673,7 +773,7 @@ mod tests {
         let mut b = Losing {
             inner: CpuBackend::new(params, l.state.clone()),
             reads: 0,
-            fail_at: 4,
+            fail_at: 5,
         };
         let opts = RunOptions {
             end: EndCondition::Steps(2000),

@@ -18,11 +18,14 @@ pub struct Sim {
     /// them after every cell, so they are the last `removed` of the arrays, and
     /// every other pass stops at `n − removed`. Counted by that pass each step.
     pub removed: u32,
-    pub _pad: u32,
+    /// The run's end time, written by the run loop (0: the run ends after a
+    /// number of steps). The timestep pass shortens the last steps to land on
+    /// it, so a run and its last frame end at the time asked for.
+    pub end_time: f32,
 }
 
 /// The limits' short names in code order (crate::model::limits::LIMITS).
-pub const DT_LIMIT_NAMES: [&str; 9] = crate::model::limits::LIMIT_NAMES;
+pub const DT_LIMIT_NAMES: [&str; 10] = crate::model::limits::LIMIT_NAMES;
 
 /// Name of the limit code the timestep pass wrote.
 pub fn dt_limit_name(code: u32) -> &'static str {

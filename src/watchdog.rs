@@ -36,10 +36,17 @@ impl Trip {
 
 /// Δt not finite, not positive or collapsed below the floor; or, when the scene's
 /// open sides stop the run, a particle has left (the scan then names it).
-/// A scene whose every limit is infinite at the start (DFSPH without gravity,
-/// heat or an explicit viscosity: its step follows the flow) has no floor.
-pub fn check_sim(m: &Model, sim: &Sim) -> Option<Trip> {
-    let floor = m.watchdog.min_dt_ratio * m.limits.min().0;
+/// The floor is `watchdog.min_dt_ratio` of the scene's smallest initial limit;
+/// where every limit is infinite (DFSPH without gravity, heat or an explicit
+/// viscosity: its step follows the flow alone), of `start_dt`, the step the
+/// run started with; none where that too is unbounded (such a scene at rest).
+pub fn check_sim(m: &Model, sim: &Sim, start_dt: f32) -> Option<Trip> {
+    let reference = match m.limits.min().0 {
+        lim if lim.is_finite() => lim,
+        _ if start_dt > 0.0 && start_dt < f32::MAX => start_dt as f64,
+        _ => f64::INFINITY,
+    };
+    let floor = m.watchdog.min_dt_ratio * reference;
     let floor = if floor.is_finite() { floor } else { 0.0 };
     let dt = sim.dt as f64;
     if m.open_sides_policy == OpenSidesPolicy::Stop && sim.removed > 0 {
@@ -365,11 +372,34 @@ mod tests {
         let (m, st) = scene();
         let mut sim = st.sim;
         sim.dt = (m.limits.min().0 * 1e-4) as f32;
-        assert!(check_sim(&m, &sim).unwrap().reason.contains("collapsed"));
+        assert!(check_sim(&m, &sim, 0.0)
+            .unwrap()
+            .reason
+            .contains("collapsed"));
         sim.dt = f32::NAN;
-        assert!(check_sim(&m, &sim).is_some());
+        assert!(check_sim(&m, &sim, 0.0).is_some());
         sim.dt = m.limits.min().0 as f32;
-        assert!(check_sim(&m, &sim).is_none());
+        assert!(check_sim(&m, &sim, 0.0).is_none());
+        // Every limit infinite (DFSPH following the flow alone): the floor is
+        // the run's first step's; none when that was unbounded too.
+        let mut free = m.clone();
+        free.limits = crate::model::DtLimits {
+            acoustic: f64::INFINITY,
+            viscous: f64::INFINITY,
+            body_force: f64::INFINITY,
+            conduction: f64::INFINITY,
+            barrier: f64::INFINITY,
+            capillary: f64::INFINITY,
+            contact: f64::INFINITY,
+            maximum: f64::INFINITY,
+        };
+        sim.dt = 1e-12;
+        assert!(check_sim(&free, &sim, 1e-8)
+            .unwrap()
+            .reason
+            .contains("collapsed"));
+        assert!(check_sim(&free, &sim, 1e-10).is_none());
+        assert!(check_sim(&free, &sim, f32::MAX).is_none());
     }
 
     /// Issue 29: liquid particles alone in the gas past the scene's share stop

@@ -20,9 +20,20 @@ fn assert_bit_identical_at(path: &str, sets: &[&str], steps: u64) -> spatter::st
 
 /// The same, returning the CPU's final state.
 fn bit_identical_state(path: &str, sets: &[&str], steps: u64) -> spatter::state::State {
+    bit_identical_prepared(path, sets, steps, |_| {})
+}
+
+/// The same from the scene's initial state as `prepare` leaves it.
+fn bit_identical_prepared(
+    path: &str,
+    sets: &[&str],
+    steps: u64,
+    prepare: impl FnOnce(&mut spatter::state::State),
+) -> spatter::state::State {
     let name = path;
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let l = load(path, &sets).unwrap();
+    let mut l = load(path, &sets).unwrap();
+    prepare(&mut l.state);
     let params = Params::new(&l.model, l.state.len() as u32);
     std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
@@ -952,4 +963,51 @@ fn dfsph_dam_break_2d_and_3d_200_steps() {
     let mut coarse = sets.to_vec();
     coarse.push("dx=0.04");
     assert_bit_identical("dam_break_3d", &coarse, 200);
+}
+
+/// The timestep pass lands on the run's end (`Sim::end_time`, which the run
+/// loop sets): within 8 steps of it the time left is shared out in equal
+/// steps, the last ending on it, and after it the steps go on unclamped (the
+/// run loop stops there; `compare` does not). The same bits on both twins, on
+/// WCSPH's and on DFSPH's step.
+#[test]
+fn timestep_lands_on_the_end_time_on_both_twins() {
+    use spatter::backend::Backend;
+    let end_code = spatter::model::limits::Limit::End.code();
+    let dfsph = [
+        DFSPH,
+        "simulation.pressure_floor=false",
+        "simulation.initial_pressure=\"zero\"",
+        "simulation.dfsph={ max_iterations = 20, viscosity_max_iterations = 20 }",
+        "dx=0.01",
+    ];
+    for sets in [&["dx=0.01"][..], &dfsph[..]] {
+        let path = common::scene("dam_break_2d");
+        let owned: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let l = load(&path, &owned).unwrap();
+        let params = Params::new(&l.model, l.state.len() as u32);
+        // An end between steps 20 and 21 of the unclamped run.
+        let mut probe = CpuBackend::new(params, l.state.clone());
+        probe.prime();
+        probe.run_steps(20);
+        let sim = probe.read_sim().unwrap();
+        let end = sim.time + 0.37 * sim.dt;
+        let st = bit_identical_prepared(&path, sets, 30, |st| st.sim.end_time = end);
+        // Replay on the CPU: the run reaches the end exactly, on a shortened step.
+        let mut prepared = l.state.clone();
+        prepared.sim.end_time = end;
+        let mut cpu = CpuBackend::new(params, prepared);
+        cpu.prime();
+        let (mut landed, mut shortened) = (false, 0);
+        for _ in 0..30 {
+            let before = cpu.read_sim().unwrap();
+            shortened += (before.dt_limit == end_code) as u32;
+            cpu.run_steps(1);
+            landed |= cpu.read_sim().unwrap().time == end;
+        }
+        assert!(landed, "{sets:?}: never at t = {end:e}");
+        // Eight or nine at a steady limit; more where the flow shortens it meanwhile.
+        assert!(shortened >= 8, "{sets:?}: {shortened} shortened steps");
+        assert!(st.sim.time > end, "{sets:?}: the steps after the end go on");
+    }
 }

@@ -19,3 +19,6 @@ fn c_nine_quarters() -> f32 { return P.consts.nine_quarters; }
 fn c_four() -> f32 { return P.consts.four; }
 fn c_tenth() -> f32 { return P.consts.tenth; }
 fn c_jacobi_floor() -> f32 { return P.consts.jacobi_floor; }
+fn c_end_slack() -> f32 { return P.consts.end_slack; }
+fn c_end_steps() -> f32 { return P.consts.end_steps; }
+fn c_end_stretch() -> f32 { return P.consts.end_stretch; }

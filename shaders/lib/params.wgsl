@@ -220,6 +220,9 @@ struct Consts {
     sin_c2: f32,
     sin_c3: f32,
     sin_c4: f32,
+    end_slack: f32,          // the end time counts as reached within this fraction of it
+    end_steps: f32,          // the approach to the end: equal steps within this many
+    end_stretch: f32,        // and up to this factor over the limits
 }
 
 // Offsets, sizes and strides follow WGSL's layout rules (encase computes the same
@@ -248,7 +251,7 @@ struct Sim {
     umax2: f32,
     amax2: f32,
     removed: u32,            // particles taken out, sorted last (issue 18)
-    pad0: u32,
+    end_time: f32,           // the run's end (0: none); the last steps land on it
 }
 
 // One solver's state in this step: twin of src/state.rs `Solver`, one per slot
@@ -366,4 +369,5 @@ const DT_BARRIER: u32 = 5u;
 const DT_CAPILLARY: u32 = 6u;
 const DT_CONTACT: u32 = 7u;
 const DT_MAXIMUM: u32 = 8u;
+const DT_END: u32 = 9u;
 const WG: u32 = 64u;

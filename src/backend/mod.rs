@@ -77,6 +77,8 @@ pub trait Backend {
     /// checkpoint, or rewind to the last good state when the watchdog trips.
     fn load_state(&mut self, st: &State);
     fn read_sim(&mut self) -> Result<Sim, DeviceLost>;
+    /// Replace the Sim block alone (the run loop sets its end time).
+    fn write_sim(&mut self, sim: &Sim);
     /// Milliseconds per pass summed since the last call, where the backend measures them.
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
         Vec::new()

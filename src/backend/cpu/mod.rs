@@ -290,6 +290,9 @@ impl Backend for CpuBackend {
     fn read_sim(&mut self) -> Result<Sim, DeviceLost> {
         Ok(self.st.sim)
     }
+    fn write_sim(&mut self, sim: &Sim) {
+        self.st.sim = *sim;
+    }
     fn load_state(&mut self, st: &State) {
         assert_eq!(
             st.len(),

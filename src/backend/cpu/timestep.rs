@@ -3,7 +3,7 @@
 //! Max over floats is exact and order-free, so this plain fold gives the same bits
 //! as the GPU's two-level tree.
 
-use crate::model::limits::Limit;
+use crate::model::limits::{toward_end, Limit};
 use crate::params::Params;
 use crate::state::State;
 use rayon::prelude::*;
@@ -28,6 +28,10 @@ pub fn run(pr: &Params, st: &mut State) {
     sim.umax2 = umax2;
     sim.amax2 = amax2;
     let (dt, which) = next_dt(pr, umax2, amax2);
+    let (dt, which) = match toward_end(sim.end_time, sim.time, dt) {
+        Some(d) => (d, Limit::End.code()),
+        None => (dt, which),
+    };
     sim.dt = dt;
     sim.dt_limit = which;
 }

@@ -411,6 +411,11 @@ impl Backend for GpuBackend {
         let bytes = self.read_bytes(&self.buf.sim, std::mem::size_of::<Sim>() as u64)?;
         Ok(bytemuck::pod_read_unaligned(&bytes))
     }
+    fn write_sim(&mut self, sim: &Sim) {
+        self.ctx
+            .queue
+            .write_buffer(&self.buf.sim, 0, bytemuck::bytes_of(sim));
+    }
     fn take_pass_times(&mut self) -> Vec<(&'static str, f64)> {
         self.profiler
             .as_mut()

@@ -1291,13 +1291,18 @@ fn array_entry<'a>(
         .ok_or_else(|| err(format!("`{name}[{k}]` is not a table")))
 }
 
-const RUN_KEYS: [&str; 6] = [
+/// Every key of `[run]` (RunDef's fields): a bare `--set` name not yet in the
+/// file goes to `[run]` when it is one of these, else to `[simulation]`.
+const RUN_KEYS: [&str; 9] = [
     "end_time",
     "steps",
     "dt",
+    "max_dt",
     "output_interval",
     "diagnostics_interval",
     "dt_check",
+    "stop_when",
+    "stop_grace",
 ];
 
 fn parse_value(raw: &str) -> toml::Value {
@@ -1307,5 +1312,24 @@ fn parse_value(raw: &str) -> toml::Value {
             .remove("v")
             .unwrap_or(toml::Value::String(raw.to_string())),
         Err(_) => toml::Value::String(raw.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// RUN_KEYS names every field of RunDef (serde's refusal of an unknown key
+    /// lists them): a bare `--set max_dt=…` once went to `[simulation]` and
+    /// exited 2.
+    #[test]
+    fn run_keys_are_every_field_of_run() {
+        let err = toml::from_str::<super::RunDef>("not_a_key = 1")
+            .unwrap_err()
+            .to_string();
+        let listed = err.split("expected one of").nth(1).expect(&err);
+        let mut fields: Vec<&str> = listed.split('`').skip(1).step_by(2).collect();
+        let mut keys = super::RUN_KEYS.to_vec();
+        fields.sort_unstable();
+        keys.sort_unstable();
+        assert_eq!(fields, keys);
     }
 }

@@ -96,15 +96,20 @@ fn finalize(@builtin(local_invocation_index) t: u32) {
         dt = P.time_step.fixed_dt;
         which = DT_FIXED;
     }
-    // Within END_STEPS steps of the run's end, the time left in equal steps
-    // that land on it (model/limits.rs toward_end).
+    // Within one step of the run's end, the time left; within END_STEPS steps,
+    // the time left in equal steps that land on it (model/limits.rs toward_end).
     let end = sim.end_time;
     let left = end - sim.time;
     if (end > 0.0 && left > c_end_slack() * end) {
-        let reach = dt * c_end_stretch();
-        if (left <= c_end_steps() * reach) {
-            dt = left / ceil(left / reach);
+        if (left <= dt) {
+            dt = left;
             which = DT_END;
+        } else {
+            let reach = dt * c_end_stretch();
+            if (left <= c_end_steps() * reach) {
+                dt = left / ceil(left / reach);
+                which = DT_END;
+            }
         }
     }
     sim.dt = dt;

@@ -252,9 +252,6 @@ impl Outputs {
     }
 }
 
-/// Steps between host reads of Δt and time: about 2e6 particle-updates, at most
-/// 200 steps. It depends on the particle count only, so chunking (and with it the
-/// step a time-ended run stops at) is the same on every run and after a resume.
 /// Tell the timestep pass the run's end time (0 for a run of so many steps), so
 /// its last steps land on it, and shorten the step already computed (by the
 /// prime or before a checkpoint) where it would cross it.
@@ -277,19 +274,22 @@ fn end_reached(end: f64, time: f32) -> bool {
     end - time <= crate::model::limits::END_SLACK * end
 }
 
-/// How many steps to run before reading back, `left` seconds before the next
-/// output or the end: the fewest steps of the longest possible length that
-/// cover it. Every step before the last of them ends short of the target, so a
-/// chunk never runs past the step that lands on the end (the steps after it
-/// would go on past). An estimate from the current Δt overshot by up to a
-/// third of the run when Δt grew inside a chunk (a DFSPH splat slowing down).
-/// Single steps where nothing bounds Δt; no bound where nothing is due (a run
-/// of so many steps without outputs).
-fn steps_toward(left: f64, longest: f64) -> u64 {
+/// The most steps to run before reading back, `left` seconds before the end:
+/// the fewest steps of the longest possible advance that cover it, so every
+/// step before the last ends short of it and a chunk never runs past the step
+/// that lands on the end (the steps after it would go on past). A step advances
+/// time by at most `longest` plus f32 time's rounding, under an ulp of the end.
+/// An estimate from the current Δt alone overshot by up to a third of the run
+/// when Δt grew inside a chunk (a DFSPH splat slowing down). Single steps
+/// where nothing bounds Δt (DFSPH without `run.max_dt`: any step may be the one
+/// that lands); no bound without an end.
+fn steps_toward(left: f64, longest: f64, end: f64) -> u64 {
     if left == f64::INFINITY {
         return u64::MAX;
     }
-    let covering = (left / longest).ceil();
+    let e = end as f32;
+    let ulp = (f32::from_bits(e.to_bits() + 1) - e) as f64;
+    let covering = (left / (longest + ulp)).ceil();
     if covering.is_finite() && covering > 1.0 {
         covering as u64
     } else {
@@ -297,6 +297,9 @@ fn steps_toward(left: f64, longest: f64) -> u64 {
     }
 }
 
+/// Steps between host reads of Δt and time: about 2e6 particle-updates, at most
+/// 200 steps. It depends on the particle count only. Where a run ends is the
+/// device's choice (the steps land on `Sim::end_time`), not the chunking's.
 fn chunk_cap(particles: usize) -> u64 {
     (2_000_000 / particles.max(1) as u64).clamp(1, 200)
 }
@@ -469,11 +472,16 @@ pub fn run(
             end = RunEnd::Interrupted;
             break;
         }
-        let target = match opts.end {
-            EndCondition::Time(te) => sched.next().min(te),
-            EndCondition::Steps(_) => sched.next(),
+        // The device's end is the f32 one.
+        let end = match opts.end {
+            EndCondition::Time(te) => (te as f32) as f64,
+            EndCondition::Steps(_) => f64::INFINITY,
         };
-        let mut chunk = steps_toward(target - t, longest);
+        let target = sched.next().min(end);
+        // Toward an output, the current Δt's estimate (a frame may come late
+        // where Δt grows); never past the step that lands on the end.
+        let estimate = ((target - t) / sim.dt as f64).ceil().max(1.0) as u64;
+        let mut chunk = estimate.min(steps_toward(end - t, longest, end));
         if let EndCondition::Steps(n) = opts.end {
             chunk = chunk.min(n - steps_done);
         }
@@ -727,21 +735,28 @@ mod tests {
         }
     }
 
-    /// A chunk is the fewest steps of the longest possible length that cover the
-    /// time left, so all but its last end short of the target; single steps
-    /// where nothing bounds Δt; unbounded where nothing is due.
+    /// A chunk is at most the fewest steps of the longest possible advance (the
+    /// step plus an ulp of the end) that cover the time left, so all but its
+    /// last end short of the end; single steps where nothing bounds Δt;
+    /// unbounded without an end.
     #[test]
     fn chunks_never_reach_past_the_end() {
-        assert_eq!(steps_toward(10.0, 1.0), 10);
-        assert_eq!(steps_toward(10.5, 1.0), 11);
-        assert_eq!(steps_toward(0.1, 1.0), 1);
-        assert_eq!(steps_toward(10.0, f64::INFINITY), 1);
-        assert_eq!(steps_toward(f64::INFINITY, 1.0), u64::MAX);
-        assert_eq!(steps_toward(f64::INFINITY, f64::INFINITY), u64::MAX);
+        assert_eq!(steps_toward(10.0, 1.0, 20.0), 10);
+        assert_eq!(steps_toward(10.5, 1.0, 20.0), 11);
+        assert_eq!(steps_toward(0.1, 1.0, 20.0), 1);
+        assert_eq!(steps_toward(10.0, f64::INFINITY, 20.0), 1);
+        assert_eq!(steps_toward(f64::INFINITY, 1.0, f64::INFINITY), u64::MAX);
         for left in [3.3, 7.0, 12.9] {
-            let k = steps_toward(left, 1.0) as f64;
-            assert!(k - 1.0 < left && k >= left, "{k} steps of 1 for {left}");
+            let k = steps_toward(left, 1.0, 20.0) as f64;
+            assert!(
+                k - 1.0 < left && k >= left - 1e-5,
+                "{k} steps of 1 for {left}"
+            );
         }
+        // Past f32's resolution of a step, the ulp is the bound's share.
+        let end = 4.0e4_f64;
+        let ulp = (f32::from_bits((end as f32).to_bits() + 1) - end as f32) as f64;
+        assert_eq!(steps_toward(10.0 * (1.0 + ulp), 1.0, end), 10);
     }
 
     /// A device lost mid-run ends it with an error naming the step it stopped at,
@@ -773,7 +788,7 @@ mod tests {
         let mut b = Losing {
             inner: CpuBackend::new(params, l.state.clone()),
             reads: 0,
-            fail_at: 5,
+            fail_at: 4,
         };
         let opts = RunOptions {
             end: EndCondition::Steps(2000),

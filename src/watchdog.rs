@@ -39,7 +39,8 @@ impl Trip {
 /// The floor is `watchdog.min_dt_ratio` of the scene's smallest initial limit;
 /// where every limit is infinite (DFSPH without gravity, heat or an explicit
 /// viscosity: its step follows the flow alone), of `start_dt`, the step the
-/// run started with; none where that too is unbounded (such a scene at rest).
+/// run started with (a resumed run's: the checkpoint's); none where that too is
+/// unbounded (such a scene at rest).
 pub fn check_sim(m: &Model, sim: &Sim, start_dt: f32) -> Option<Trip> {
     let reference = match m.limits.min().0 {
         lim if lim.is_finite() => lim,

@@ -186,6 +186,10 @@ enum BenchKind {
         /// First seed of the random scenes (scene k uses seed + k).
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Only the cases whose group ("long run", "extreme", "random"),
+        /// parameter family ("impact speed") or scene name contains this text.
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -425,11 +429,13 @@ fn cmd_bench(which: BenchKind) -> Result<ExitCode, SpatterError> {
             quick,
             json,
             seed,
+            only,
         } => bench::stability::stability(&bench::stability::Options {
             backend,
             quick,
             json: json.as_deref(),
             seed,
+            only: only.as_deref(),
         })
         .map(|ok| {
             if ok {

@@ -120,6 +120,28 @@ fn stability_quick_has_no_crash() {
     }
 }
 
+/// `--only` keeps the cases whose group, family or name contains its text:
+/// J22's droplet at 200 m/s alone (`--quick`); a text that matches nothing
+/// exits 2 and lists the groups and families.
+#[test]
+fn stability_only_runs_the_cases_it_names() {
+    let v = run_json(
+        &["bench", "stability", "--quick", "--only", "impact speed"],
+        "bench-stability-only",
+    );
+    let cases = v["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 1, "{v}");
+    assert_eq!(cases[0]["family"], "impact speed (m/s)");
+    assert_ne!(cases[0]["outcome"], "crashed", "{}", cases[0]);
+    let out = common::spatter(&["bench", "stability", "--quick", "--only", "no such case"]);
+    let (_, stderr) = common::text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--only") && stderr.contains("impact speed"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn unknown_accuracy_scene_is_an_input_error() {
     let out = common::spatter(&["bench", "accuracy", "--scenes", "no_such_scene"]);

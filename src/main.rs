@@ -822,7 +822,7 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),
         None => println!("time step: adaptive, initially {lim:.4e} s"),
     }
-    print_cost(m, st.len(), lim);
+    print_cost(m, st, lim);
     let params = Params::new(m, st.len() as u32);
     let pipeline = Pipeline::for_scene(&params, st);
     println!("passes: {}", pipeline.pass_names().join(", "));
@@ -837,17 +837,40 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
 /// line_melt_bare_plate (2.8e5 particles, 2026-11-23), the CPU on melt_block_3d.
 const PLAIN_RATES: (f64, f64) = (1.34e8, 1.7e6);
 const HEAT_RATES: (f64, f64) = (3.65e7, 4.3e5);
+/// DFSPH (its solves are several neighbour sweeps a step): the CPU on the
+/// 30 um spray spread at 48 540 particles (2026-12-05, the slowest per particle
+/// of the spray scenes; the 3D Fluent case at 11 346 ran at 2.9e5). No GPU
+/// figure: no device has been lent since DFSPH landed.
+const DFSPH_CPU_RATE: f64 = 4.7e4;
 
-/// `validate`'s cost line: steps at the initial time step, particle-steps, and
-/// the wall time they project to on one H100 and on 2 CPU cores.
-fn print_cost(m: &spatter::model::Model, particles: usize, dt0: f64) {
+/// `validate`'s cost line: steps at the initial time step (the smallest of the
+/// scene's limits and of the flow's own CFL at its initial speeds, which binds
+/// a 200 m/s droplet on DFSPH), particle-steps, and the wall time they project
+/// to on one H100 and on 2 CPU cores.
+fn print_cost(m: &spatter::model::Model, st: &spatter::state::State, limit: f64) {
+    let umax = (0..st.len())
+        .filter(|&i| m.phases[st.phase[i] as usize].is_fluid())
+        .map(|i| {
+            let v = st.vel[i];
+            ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
+        })
+        .fold(0.0, f64::max);
+    let speed = m.max_sound_speed() + umax;
+    let dt0 = if speed > 0.0 {
+        limit.min(0.25 * m.h / speed)
+    } else {
+        limit
+    };
     let steps = match m.end {
         spatter::model::EndCondition::Steps(n) => n as f64,
         spatter::model::EndCondition::Time(t) => (t / m.fixed_dt.unwrap_or(dt0)).ceil(),
     };
-    let work = steps * particles as f64;
+    let work = steps * st.len() as f64;
     let heat = m.phases.iter().any(|p| p.conducts());
-    let ((gpu, cpu), which) = if heat {
+    let dfsph = m.formulation == spatter::scene::Formulation::Dfsph;
+    let ((gpu, cpu), which) = if dfsph {
+        ((f64::NAN, DFSPH_CPU_RATE), "a DFSPH spray scene's")
+    } else if heat {
         (HEAT_RATES, "a laser heat scene's")
     } else {
         (PLAIN_RATES, "plain WCSPH's")
@@ -864,13 +887,20 @@ fn print_cost(m: &spatter::model::Model, particles: usize, dt0: f64) {
     };
     let adaptive = if m.fixed_dt.is_some() {
         ""
+    } else if dfsph {
+        " (at the initial speeds; DFSPH's step follows the flow: the spray scenes took \
+         0.37-1.23 times this)"
     } else {
         " (the step adapts: more steps where the flow speeds up)"
     };
+    let on_gpu = if gpu.is_finite() {
+        format!("{} on one H100 ({gpu:.2e}/s)", hours(gpu))
+    } else {
+        "on one H100 not measured yet (no device lent since DFSPH landed)".to_string()
+    };
     println!(
         "cost: about {steps:.3e} steps{adaptive}, {work:.3e} particle-steps; at {which} measured \
-         rates (docs/benchmarks.md) {} on one H100 ({gpu:.2e}/s), {} on 2 CPU cores ({cpu:.2e}/s)",
-        hours(gpu),
+         rates (docs/benchmarks.md) {on_gpu}, {} on 2 CPU cores ({cpu:.2e}/s)",
         hours(cpu)
     );
 }

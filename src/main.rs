@@ -839,7 +839,7 @@ const PLAIN_RATES: (f64, f64) = (1.34e8, 1.7e6);
 const HEAT_RATES: (f64, f64) = (3.65e7, 4.3e5);
 /// DFSPH (its solves are several neighbour sweeps a step): the CPU on the
 /// 30 um spray spread at 48 540 particles (2026-12-05, the slowest per particle
-/// of the spray scenes; the 3D Fluent case at 11 346 ran at 2.9e5). No GPU
+/// of the spray scenes; the 3D Fluent case at 11 364 ran at 3.0e5). No GPU
 /// figure: no device has been lent since DFSPH landed.
 const DFSPH_CPU_RATE: f64 = 4.7e4;
 

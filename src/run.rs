@@ -473,15 +473,15 @@ pub fn run(
             break;
         }
         // The device's end is the f32 one.
-        let end = match opts.end {
+        let end_time = match opts.end {
             EndCondition::Time(te) => (te as f32) as f64,
             EndCondition::Steps(_) => f64::INFINITY,
         };
-        let target = sched.next().min(end);
+        let target = sched.next().min(end_time);
         // Toward an output, the current Δt's estimate (a frame may come late
         // where Δt grows); never past the step that lands on the end.
         let estimate = ((target - t) / sim.dt as f64).ceil().max(1.0) as u64;
-        let mut chunk = estimate.min(steps_toward(end - t, longest, end));
+        let mut chunk = estimate.min(steps_toward(end_time - t, longest, end_time));
         if let EndCondition::Steps(n) = opts.end {
             chunk = chunk.min(n - steps_done);
         }

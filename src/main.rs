@@ -822,8 +822,8 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
         Some(dt) => println!("time step: fixed {dt:.4e} s (limit {lim:.4e} s)"),
         None => println!("time step: adaptive, initially {lim:.4e} s"),
     }
-    print_cost(m, st, lim);
     let params = Params::new(m, st.len() as u32);
+    print_cost(m, &params, st, lim);
     let pipeline = Pipeline::for_scene(&params, st);
     println!("passes: {}", pipeline.pass_names().join(", "));
     println!("step: {}", pipeline.describe_step());
@@ -847,20 +847,17 @@ const DFSPH_CPU_RATE: f64 = 4.7e4;
 /// scene's limits and of the flow's own CFL at its initial speeds, which binds
 /// a 200 m/s droplet on DFSPH), particle-steps, and the wall time they project
 /// to on one H100 and on 2 CPU cores.
-fn print_cost(m: &spatter::model::Model, st: &spatter::state::State, limit: f64) {
-    let umax = (0..st.len())
+fn print_cost(m: &spatter::model::Model, params: &Params, st: &spatter::state::State, limit: f64) {
+    // The timestep pass's own formula at the initial speeds (acoustic, or
+    // DFSPH's flow CFL) beside the scene's constant limits.
+    let umax2 = (0..st.len())
         .filter(|&i| m.phases[st.phase[i] as usize].is_fluid())
         .map(|i| {
             let v = st.vel[i];
-            ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
+            v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
         })
-        .fold(0.0, f64::max);
-    let speed = m.max_sound_speed() + umax;
-    let dt0 = if speed > 0.0 {
-        limit.min(0.25 * m.h / speed)
-    } else {
-        limit
-    };
+        .fold(0.0f32, f32::max);
+    let dt0 = limit.min(spatter::backend::cpu::next_dt(params, umax2, 0.0).0 as f64);
     let steps = match m.end {
         spatter::model::EndCondition::Steps(n) => n as f64,
         spatter::model::EndCondition::Time(t) => (t / m.fixed_dt.unwrap_or(dt0)).ceil(),

@@ -304,33 +304,15 @@ fn chunk_cap(particles: usize) -> u64 {
     (2_000_000 / particles.max(1) as u64).clamp(1, 200)
 }
 
-/// The longest step the timestep pass can take (f32, as it computes): the
-/// fixed Δt, or the smallest of the constant limits and the acoustic one at
-/// rest (|u| only shortens it; the force limit is left out, since the flow's
-/// accelerations can fall below gravity's). ∞ when nothing bounds it (DFSPH
-/// without `run.max_dt` and without other limits).
-fn longest_step(ts: &crate::params::TimeStep, h: f32) -> f64 {
-    if ts.fixed_dt > 0.0 {
-        return ts.fixed_dt as f64;
-    }
-    let mut dt = f32::MAX;
-    if ts.max_sound_speed > 0.0 {
-        dt = 0.25 * h / ts.max_sound_speed;
-    }
-    for lim in [
-        ts.viscous_limit,
-        ts.conduction_limit,
-        ts.barrier_limit,
-        ts.capillary_limit,
-        ts.contact_limit,
-        ts.maximum_limit,
-    ] {
-        dt = dt.min(lim);
-    }
-    if dt == f32::MAX {
-        f64::INFINITY
-    } else {
-        dt as f64
+/// The longest step the timestep pass can take: its own formula at rest (|u|
+/// only shortens the acoustic limit; with no acceleration the force limit is
+/// left out, since the flow's can fall below gravity's); the fixed Δt where
+/// there is one. ∞ when nothing bounds it (DFSPH without `run.max_dt` and
+/// without other limits).
+fn longest_step(pr: &Params) -> f64 {
+    match crate::backend::cpu::next_dt(pr, 0.0, 0.0).0 {
+        f32::MAX => f64::INFINITY,
+        dt => dt as f64,
     }
 }
 
@@ -452,8 +434,8 @@ pub fn run(
     out.diagnostics(m, &st, &observers).map_err(rt)?;
     let cap = chunk_cap(st.len());
     // The approach to the end may stretch a step by END_STRETCH.
-    let longest = longest_step(&Params::new(m, st.len() as u32).time_step, m.h as f32)
-        * crate::model::limits::END_STRETCH as f64;
+    let longest =
+        longest_step(&Params::new(m, st.len() as u32)) * crate::model::limits::END_STRETCH as f64;
     let mut steps_done = 0u64;
     let start_dt = sim.dt;
     let mut trip = watchdog::check_sim(m, &sim, start_dt).or_else(|| watchdog::scan(m, &st));

@@ -17,6 +17,9 @@ mod reduce;
 mod surface_forces;
 mod terms;
 mod timestep;
+/// The time step F22 (42) gives for given |u|max² and |a|max², as the pass
+/// computes it: the host evaluates it for the longest step a run can take.
+pub use timestep::next_dt;
 mod wall;
 
 use super::schedule::SolverSlot;

@@ -1,15 +1,16 @@
 //! Smoothing kernels, CPU side. Twin of shaders/lib/kernel.wgsl: same formulas in the
 //! same operation order (no mul_add), so both give the same bits (DESIGN rule 1).
 
+use crate::lanes::Lane;
 use crate::params::Params;
 
 #[inline(always)]
-fn p4(t: f32) -> f32 {
+fn p4<R: Lane>(t: R) -> R {
     t * t * t * t
 }
 
 #[inline(always)]
-fn p5(t: f32) -> f32 {
+fn p5<R: Lane>(t: R) -> R {
     t * t * t * t * t
 }
 
@@ -24,44 +25,48 @@ pub fn w(pr: &Params, r: f32) -> f32 {
     }
 }
 
+// The kernels on one distance or on eight (`Lane`), with the same operations.
+
 #[inline(always)]
-fn w_quintic(sigma: f32, h_inv: f32, r: f32) -> f32 {
-    let q = r * h_inv;
-    let t1 = (1.0 - q).max(0.0);
-    let t2 = (2.0 - q).max(0.0);
-    let t3 = (3.0 - q).max(0.0);
-    sigma * (p5(t3) - 6.0 * p5(t2) + 15.0 * p5(t1))
+fn w_quintic<R: Lane>(sigma: f32, h_inv: f32, r: R) -> R {
+    let c = R::splat;
+    let q = r * c(h_inv);
+    let t1 = (c(1.0) - q).max0();
+    let t2 = (c(2.0) - q).max0();
+    let t3 = (c(3.0) - q).max0();
+    c(sigma) * (p5(t3) - c(6.0) * p5(t2) + c(15.0) * p5(t1))
 }
 
 #[inline(always)]
-fn w_wendland_c2(sigma: f32, h_inv: f32, r: f32) -> f32 {
-    let q = r * h_inv;
-    let t = (1.0 - 0.5 * q).max(0.0);
-    sigma * p4(t) * (2.0 * q + 1.0)
+fn w_wendland_c2<R: Lane>(sigma: f32, h_inv: f32, r: R) -> R {
+    let c = R::splat;
+    let q = r * c(h_inv);
+    let t = (c(1.0) - c(0.5) * q).max0();
+    c(sigma) * p4(t) * (c(2.0) * q + c(1.0))
 }
 
 /// Both pieces are evaluated and one is selected, so that a batch of these
 /// vectorises; each piece has the same operations as a branch would.
 #[inline(always)]
-fn w_cubic(sigma: f32, h_inv: f32, r: f32) -> f32 {
-    let q = r * h_inv;
-    let inner = sigma * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
-    let t = 2.0 - q;
-    let outer = sigma * 0.25 * t * t * t;
-    if q < 1.0 {
-        inner
-    } else if q < 2.0 {
-        outer
-    } else {
-        0.0
-    }
+fn w_cubic<R: Lane>(sigma: f32, h_inv: f32, r: R) -> R {
+    let c = R::splat;
+    let q = r * c(h_inv);
+    let inner = c(sigma) * (c(1.0) - c(1.5) * q * q + c(0.75) * q * q * q);
+    let t = c(2.0) - q;
+    let outer = c(sigma) * c(0.25) * t * t * t;
+    q.where_lt(1.0, inner, q.where_lt(2.0, outer, c(0.0)))
 }
 
 /// Σ_k W(√r2_k) summed in the order given: the same bits as adding `w` one
 /// neighbour at a time. The kernel values of a block are computed first, in a
-/// loop without branches that the compiler vectorises (4 lanes with SSE2), and
-/// then added in order.
+/// loop without branches (eight lanes with AVX2; otherwise the compiler
+/// vectorises it, 4 lanes with SSE2), and then added in order.
 pub fn sum_w(pr: &Params, r2: &[f32]) -> f32 {
+    #[cfg(target_arch = "x86_64")]
+    if *crate::lanes::AVX2 {
+        // SAFETY: the CPU has AVX2 (checked once at run time).
+        return unsafe { sum_w_avx2(pr, r2) };
+    }
     let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
     match pr.kernel.kind {
         0 => sum_in_order(r2, |r| w_quintic(sigma, h_inv, r)),
@@ -86,31 +91,60 @@ fn sum_in_order(r2: &[f32], w: impl Fn(f32) -> f32) -> f32 {
     sum
 }
 
-/// dW/dr for the kernel chosen in `params.kernel.kind`.
+/// `sum_w` eight distances at a time (the tail one at a time), the kernel in
+/// eight lanes with the scalar kernel's operations, then added in order.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sum_w_avx2(pr: &Params, r2: &[f32]) -> f32 {
+    use crate::lanes::F8;
+    use std::arch::x86_64::{_mm256_loadu_ps, _mm256_sqrt_ps};
+    let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
+    let kernel8 = |r: F8| match pr.kernel.kind {
+        0 => w_quintic(sigma, h_inv, r),
+        1 => w_wendland_c2(sigma, h_inv, r),
+        _ => w_cubic(sigma, h_inv, r),
+    };
+    let mut sum = 0.0f32;
+    let blocks = r2.chunks_exact(8);
+    let tail = blocks.remainder();
+    for block in blocks {
+        // SAFETY: the block holds eight f32; AVX is enabled here.
+        let x = unsafe { _mm256_loadu_ps(block.as_ptr()) };
+        let values = kernel8(F8(_mm256_sqrt_ps(x))).to_array();
+        for v in values {
+            sum += v;
+        }
+    }
+    for &x in tail {
+        sum += w(pr, x.sqrt());
+    }
+    sum
+}
+
+/// dW/dr for the kernel chosen in `params.kernel.kind`, on one distance or on
+/// eight (`Lane`): the same operations either way. The cubic's two pieces are
+/// both evaluated and one is selected, each with the operations a branch has.
 #[inline(always)]
-pub fn dw(pr: &Params, r: f32) -> f32 {
-    let sigma_h = pr.kernel.sigma * pr.kernel.inv_h;
-    let q = r * pr.kernel.inv_h;
+pub fn dw<R: Lane>(pr: &Params, r: R) -> R {
+    let c = R::splat;
+    let sigma_h = c(pr.kernel.sigma * pr.kernel.inv_h);
+    let q = r * c(pr.kernel.inv_h);
     match pr.kernel.kind {
         0 => {
-            let t1 = (1.0 - q).max(0.0);
-            let t2 = (2.0 - q).max(0.0);
-            let t3 = (3.0 - q).max(0.0);
-            sigma_h * (-5.0 * p4(t3) + 30.0 * p4(t2) - 75.0 * p4(t1))
+            let t1 = (c(1.0) - q).max0();
+            let t2 = (c(2.0) - q).max0();
+            let t3 = (c(3.0) - q).max0();
+            sigma_h * (c(-5.0) * p4(t3) + c(30.0) * p4(t2) - c(75.0) * p4(t1))
         }
         1 => {
-            let t = (1.0 - 0.5 * q).max(0.0);
-            sigma_h * (-5.0 * q * t * t * t)
+            let t = (c(1.0) - c(0.5) * q).max0();
+            sigma_h * (c(-5.0) * q * t * t * t)
         }
         _ => {
-            if q < 1.0 {
-                sigma_h * (-3.0 * q + 2.25 * q * q)
-            } else if q < 2.0 {
-                let t = 2.0 - q;
-                sigma_h * (-0.75 * t * t)
-            } else {
-                0.0
-            }
+            let inner = sigma_h * (c(-3.0) * q + c(2.25) * q * q);
+            let t = c(2.0) - q;
+            let outer = sigma_h * (c(-0.75) * t * t);
+            q.where_lt(1.0, inner, q.where_lt(2.0, outer, c(0.0)))
         }
     }
 }
@@ -189,6 +223,54 @@ mod tests {
                     (fd - an).abs() < 1e-3 * scale + 1e-3 * an.abs(),
                     "{kind:?} r={r}: fd {fd} vs {an}"
                 );
+            }
+        }
+    }
+
+    /// `sum_w` (eight lanes with AVX2) and `dw` on eight lanes give the bits of
+    /// the scalar kernels added one neighbour at a time, for every kernel, on
+    /// lists of 0 to 40 distances that cross every piece of each kernel and its
+    /// support (and r = 0).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn eight_lanes_give_the_scalar_kernel_bits() {
+        use crate::lanes::{AVX2, F8};
+        use std::arch::x86_64::_mm256_loadu_ps;
+        if !*AVX2 {
+            return;
+        }
+        #[target_feature(enable = "avx2")]
+        fn dw8(pr: &Params, r: &[f32; 8]) -> [f32; 8] {
+            // SAFETY: AVX2 is enabled in this function; r holds eight f32.
+            dw(pr, F8(unsafe { _mm256_loadu_ps(r.as_ptr()) })).to_array()
+        }
+        for kind in [
+            KernelKind::Quintic,
+            KernelKind::WendlandC2,
+            KernelKind::Cubic,
+        ] {
+            let h = 0.7;
+            let p = params(kind, 3, h);
+            let reach = (kind.support_factor() * h * 1.1) as f32;
+            let r: Vec<f32> = (0..40)
+                .map(|k| ((k * 37 % 41) as f32 / 40.0) * reach)
+                .collect();
+            for n in 0..=r.len() {
+                let r2: Vec<f32> = r[..n].iter().map(|r| r * r).collect();
+                let one_by_one = r2.iter().fold(0.0f32, |s, &x| s + w(&p, x.sqrt()));
+                assert_eq!(
+                    sum_w(&p, &r2).to_bits(),
+                    one_by_one.to_bits(),
+                    "{kind:?}, {n}"
+                );
+            }
+            for block in r.chunks_exact(8) {
+                let block: [f32; 8] = block.try_into().unwrap();
+                // SAFETY: the CPU has AVX2 (checked above).
+                let lanes = unsafe { dw8(&p, &block) };
+                for (k, &x) in block.iter().enumerate() {
+                    assert_eq!(lanes[k].to_bits(), dw(&p, x).to_bits(), "{kind:?}, r = {x}");
+                }
             }
         }
     }

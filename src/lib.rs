@@ -13,6 +13,7 @@ pub mod fields;
 pub mod gpu_layout;
 pub mod inspect;
 pub mod kernel;
+pub mod lanes;
 pub mod model;
 pub mod outflow;
 pub mod output;

@@ -259,8 +259,9 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
                 if br && r < pr.flow.barrier_radius {
                     // F22 (34) as the forces pass applies it to the fluid from a
                     // wall particle: the wall phase's velocity, not the body's.
-                    let w = pr.phase(phase[i]).velocity.to_array();
-                    let s = terms::barrier(pr, v_j, w, dj, r);
+                    let w = pr.phase(phase[i]).velocity;
+                    let v = [v_j[0], v_j[1], v_j[2]];
+                    let s = terms::barrier(pr, v, [w.x, w.y, w.z], dj, r);
                     for c in 0..3 {
                         f[c] -= s * dj[c];
                     }

@@ -40,6 +40,16 @@ macro_rules! monomorphise {
 /// The sweep with the scene's switchable pair terms compiled in and the others
 /// compiled out (backend::terms), one const parameter of `sweep` per switch.
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
+    #[cfg(target_arch = "x86_64")]
+    if super::forces_avx2::applies(pr) {
+        let eta = PairViscosity::new(pr);
+        return super::forces_avx2::run(pr, st, grid, list, &eta.0);
+    }
+    scalar(pr, st, grid, list)
+}
+
+/// `run` one neighbour at a time, whatever the CPU and scene.
+pub(super) fn scalar(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     monomorphise!(sweep::<>(pr, st, grid, list); [
         active(pr, "background_pressure"),
         active(pr, "interface_viscosity"),
@@ -204,7 +214,8 @@ fn sweep<
                     heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
                 }
                 if BR && wall && r < pr.flow.barrier_radius {
-                    let s = terms::barrier(pr, v_i, mat_j.velocity.to_array(), d, r);
+                    let w = mat_j.velocity;
+                    let s = terms::barrier(pr, xyz(v_i), [w.x, w.y, w.z], d, r);
                     for a in 0..3 {
                         f[a] += s * d[a];
                     }
@@ -219,6 +230,12 @@ fn sweep<
             ];
             *acc_b = [fb[0] / m_i, fb[1] / m_i, fb[2] / m_i, 0.0];
         });
+}
+
+/// The first three components.
+#[inline(always)]
+fn xyz(v: [f32; 4]) -> [f32; 3] {
+    [v[0], v[1], v[2]]
 }
 
 /// η̃_ij for every (fluid phase i, phase j), from `terms::pair_viscosity`: a wall

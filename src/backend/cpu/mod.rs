@@ -8,6 +8,8 @@ mod density;
 mod dfsph;
 mod dfsph_viscosity;
 mod forces;
+#[cfg(target_arch = "x86_64")]
+mod forces_avx2;
 mod heat;
 mod integrate;
 mod interface;

@@ -232,28 +232,40 @@ pub fn for_each_listed(
     i: usize,
     mut f: impl FnMut(usize, [f32; 3], f32),
 ) {
-    let mut swept = None;
-    let js = match list.of(grid, i) {
-        Some(js) => js,
-        None => {
-            let mut js = SCRATCH.with(|s| s.take());
-            with_neighbors(pr, pos, grid, i, |found, _| {
-                js.clear();
-                js.extend_from_slice(found);
-            });
-            &**swept.insert(js)
+    with_listed(pr, pos, grid, list, i, |js| {
+        let pi = pos[i];
+        for &j in js {
+            let j = j as usize;
+            let d = min_image(pr, pi, pos[j]);
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            f(j, d, r2);
         }
-    };
-    let pi = pos[i];
-    for &j in js {
-        let j = j as usize;
-        let d = min_image(pr, pi, pos[j]);
-        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        f(j, d, r2);
+    })
+}
+
+/// `f` gets the neighbours j of fluid particle i, in `for_each_listed`'s order,
+/// as one slice: the step's list, or the cells swept into a per-thread scratch
+/// list when the step has none.
+#[inline(always)]
+pub fn with_listed<R>(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    list: &NeighborList,
+    i: usize,
+    f: impl FnOnce(&[u32]) -> R,
+) -> R {
+    if let Some(js) = list.of(grid, i) {
+        return f(js);
     }
-    if let Some(js) = swept {
-        SCRATCH.with(|s| s.replace(js));
-    }
+    let mut js = SCRATCH.with(|s| s.take());
+    with_neighbors(pr, pos, grid, i, |found, _| {
+        js.clear();
+        js.extend_from_slice(found);
+    });
+    let out = f(&js);
+    SCRATCH.with(|s| s.replace(js));
+    out
 }
 
 thread_local! {
@@ -465,8 +477,7 @@ impl Candidates {
 }
 
 #[cfg(target_arch = "x86_64")]
-static AVX2: std::sync::LazyLock<bool> =
-    std::sync::LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
+use crate::lanes::AVX2;
 
 /// For each 8-bit mask, the lanes whose bit is set, in order, then the rest:
 /// the permutation that packs a mask's lanes to the front.

@@ -4,7 +4,10 @@
 //! p_b = 0 every term is ±0 and the sum stays +0. Twin of
 //! shaders/terms/background_pressure.wgsl.
 
+use crate::lanes::Lane;
+
+/// On one neighbour or on eight (`Lane`), with the same operations.
 #[inline(always)]
-pub fn background_pressure(pb: f32, dwdr: f32, r: f32) -> f32 {
+pub fn background_pressure<R: Lane>(pb: R, dwdr: R, r: R) -> R {
     -pb * dwdr / r
 }

@@ -5,16 +5,18 @@
 //! Returns s with F = s d (d = r_i − r_j, e_ij = d/r). Twin of
 //! shaders/terms/barrier.wgsl.
 
+use crate::lanes::Lane;
 use crate::params::Params;
 
+/// On one pair or on eight (`Lane`), with the same operations.
 #[inline(always)]
-pub fn barrier(pr: &Params, v_i: [f32; 4], w: [f32; 4], d: [f32; 3], r: f32) -> f32 {
+pub fn barrier<R: Lane>(pr: &Params, v_i: [R; 3], w: [R; 3], d: [R; 3], r: R) -> R {
     let f = &pr.flow;
-    let g = f.barrier_radius - r;
+    let g = R::splat(f.barrier_radius) - r;
     let un = d[0] * (v_i[0] - w[0]) + d[1] * (v_i[1] - w[1]) + d[2] * (v_i[2] - w[2]);
     let g_dot = -(un / r);
-    let stiff = f.barrier_stiffness * g;
-    let damp = (f.barrier_damping * g) * g_dot;
+    let stiff = R::splat(f.barrier_stiffness) * g;
+    let damp = (R::splat(f.barrier_damping) * g) * g_dot;
     (stiff + damp) / r
 }
 
@@ -39,9 +41,8 @@ mod tests {
     fn spring_and_damper_along_the_pair_axis() {
         let p = params(0.01, 2000.0, 500.0);
         let d = [0.0, 0.0, 0.004];
-        let force = |v: f32, w: f32| {
-            super::barrier(&p, [0.0, 0.0, v, 0.0], [0.0, 0.0, w, 0.0], d, 0.004) * d[2]
-        };
+        let force =
+            |v: f32, w: f32| super::barrier(&p, [0.0, 0.0, v], [0.0, 0.0, w], d, 0.004) * d[2];
         assert!((force(0.0, 0.0) - 12.0).abs() < 1e-4, "{}", force(0.0, 0.0));
         assert!(
             (force(-2.0, 0.0) - 18.0).abs() < 1e-4,
@@ -51,7 +52,7 @@ mod tests {
         assert!((force(2.0, 0.0) - 6.0).abs() < 1e-4, "{}", force(2.0, 0.0));
         assert!((force(-1.0, 1.0) - force(-2.0, 0.0)).abs() < 1e-4);
         // Tangential motion leaves it a spring.
-        let slide = super::barrier(&p, [3.0, 0.0, 0.0, 0.0], [0.0; 4], d, 0.004) * d[2];
+        let slide = super::barrier(&p, [3.0, 0.0, 0.0], [0.0; 3], d, 0.004) * d[2];
         assert!((slide - 12.0).abs() < 1e-4, "{slide}");
     }
 }

@@ -2,8 +2,11 @@
 //! on i along r_ij per (V_i² + V_j²) is −p̃ (∂W/∂r)/r. Twin of
 //! shaders/terms/pressure.wgsl.
 
+use crate::lanes::Lane;
+
+/// On one neighbour or on eight (`Lane`), with the same operations.
 #[inline(always)]
-pub fn pressure(p_i: f32, p_j: f32, rho_i: f32, rho_j: f32, dwdr: f32, r: f32) -> f32 {
+pub fn pressure<R: Lane>(p_i: R, p_j: R, rho_i: R, rho_j: R, dwdr: R, r: R) -> R {
     let p_avg = (rho_j * p_i + rho_i * p_j) / (rho_i + rho_j);
     -p_avg * dwdr / r
 }

@@ -3,6 +3,8 @@
 //! Twin of shaders/terms/viscosity.wgsl. The CPU sweep reads η̃ from a table built
 //! with `pair_viscosity` per phase pair (same operands, same bits).
 
+use crate::lanes::Lane;
+
 #[inline(always)]
 pub fn pair_viscosity(eta_i: f32, eta_j: f32, slip: bool) -> f32 {
     let eta_sum = eta_i + eta_j;
@@ -13,7 +15,8 @@ pub fn pair_viscosity(eta_i: f32, eta_j: f32, slip: bool) -> f32 {
     }
 }
 
+/// On one neighbour or on eight (`Lane`), with the same operations.
 #[inline(always)]
-pub fn viscosity(eta_avg: f32, dwdr: f32, r: f32) -> f32 {
+pub fn viscosity<R: Lane>(eta_avg: R, dwdr: R, r: R) -> R {
     eta_avg * dwdr / r
 }

@@ -51,12 +51,14 @@ mod avx {
     use std::arch::x86_64::*;
     use std::ops::{Add, Div, Mul, Neg, Sub};
 
-    /// Whether this CPU has AVX2 (checked once, at first use).
-    pub static AVX2: std::sync::LazyLock<bool> =
-        std::sync::LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
+    /// Whether this CPU has AVX2 and POPCNT (checked once, at first use; every
+    /// AVX2 CPU has POPCNT, which the neighbour compaction counts lanes with).
+    pub static AVX2: std::sync::LazyLock<bool> = std::sync::LazyLock::new(|| {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("popcnt")
+    });
 
     /// Eight f32 in one AVX register. Only code compiled with
-    /// `#[target_feature(enable = "avx2")]` makes one (`F8::from`), so every
+    /// `#[target_feature(enable = "avx2")]` makes one (from an intrinsic), so every
     /// operation below runs where AVX is present; each is `#[inline(always)]`
     /// so that it is compiled into that caller with its features.
     #[derive(Clone, Copy)]

@@ -90,6 +90,9 @@ pub struct BenchRow {
     /// reorder scratch, sort keys, and the cell table spread over the particles
     /// (setup::memory_estimate).
     pub bytes_per_particle: f64,
+    /// The CPU backend's neighbour list on top (cpu/neighbors.rs `NeighborList`:
+    /// 4 bytes per fluid pair and per particle), None on the GPU, which keeps none.
+    pub list_bytes_per_particle: Option<f64>,
     pub pass_ms: Vec<(String, f64)>,
 }
 
@@ -205,6 +208,10 @@ fn measure(
         pair_interactions_per_s: per_fluid(pairs as f64 * steps as f64 / wall_s),
         neighbours_per_fluid_particle: per_fluid(pairs as f64 / fluid.max(1) as f64),
         bytes_per_particle: setup::memory_estimate(&l.model, n as f64) / n as f64,
+        list_bytes_per_particle: backend
+            .describe()
+            .starts_with("cpu")
+            .then(|| 4.0 * (pairs as f64 + n as f64) / n as f64),
         pass_ms: Vec::new(),
     })
 }
@@ -565,8 +572,11 @@ fn print_row(r: &BenchRow) {
     } else {
         ("no fluid at the start".into(), "-".into())
     };
+    let list = r
+        .list_bytes_per_particle
+        .map_or(String::new(), |b| format!(" + {b:.0} B neighbour list"));
     println!(
-        "{} | {} particles (dx {:.3e} m, {neighbours}, {:.0} B/particle) | {:.3e} particle-steps/s | {pairs} fluid pair interactions/s | {:.3} s for {} steps",
+        "{} | {} particles (dx {:.3e} m, {neighbours}, {:.0} B/particle{list}) | {:.3e} particle-steps/s | {pairs} fluid pair interactions/s | {:.3} s for {} steps",
         r.backend, r.particles, r.dx, r.bytes_per_particle, r.particle_steps_per_s, r.wall_s, r.steps
     );
     if !r.pass_ms.is_empty() {
@@ -598,6 +608,7 @@ mod tests {
             pair_interactions_per_s: rate * fluid as f64 / particles as f64 * pairs_per_fluid,
             neighbours_per_fluid_particle: pairs_per_fluid,
             bytes_per_particle: 0.0,
+            list_bytes_per_particle: None,
             pass_ms: vec![
                 ("density".into(), 1e-6 * ns * 0.4 * particles as f64),
                 ("forces".into(), 1e-6 * ns * 0.6 * particles as f64),

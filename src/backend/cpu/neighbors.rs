@@ -24,6 +24,10 @@ pub struct CellTable {
     /// Changes whenever the table is rebuilt or the positions it indexes are
     /// replaced (`invalidate`); 0 = never built.
     pub generation: u64,
+    /// The last sort's (cell, particle) keys and permutation, kept so that the
+    /// next sort reuses their memory (fresh arrays are cleared page by page).
+    keys: Vec<(u32, u32)>,
+    perm: Vec<usize>,
 }
 
 impl CellTable {
@@ -147,9 +151,20 @@ pub fn with_neighbors<R>(
 /// Particles per chunk of the neighbour list (one parallel task each).
 pub const LIST_CHUNK: usize = 1024;
 
-/// Most neighbour indices the list holds (512 MiB); a step that would need more
-/// records none, and its later passes sweep the cells themselves.
-const LIST_MAX_ENTRIES: usize = 1 << 27;
+/// Most neighbour indices the list holds: half the memory this machine had free
+/// when the first list was stored (4 bytes an index), or 2^27 indices (512 MiB)
+/// where that is unknown. A step that would need more records none, and its
+/// later passes sweep the cells themselves (at 1e7 particles of dam_break_3d the
+/// list takes 2.6 GB and halves the forces pass).
+static LIST_MAX_ENTRIES: std::sync::LazyLock<usize> =
+    std::sync::LazyLock::new(|| match crate::setup::available_memory() {
+        Some(free) => (free / 2.0 / 4.0) as usize,
+        None => 1 << 27,
+    });
+
+/// Steps a list that outgrew LIST_MAX_ENTRIES is not recorded for before the
+/// next try (recording one only to drop it doubles the density pass's cost).
+const LIST_RETRY_STEPS: u32 = 100;
 
 /// The neighbours of every fluid particle, recorded by the density pass in the
 /// walk's order, so that the forces pass of the same step reads them instead of
@@ -158,6 +173,8 @@ const LIST_MAX_ENTRIES: usize = 1 << 27;
 pub struct NeighborList {
     generation: u64,
     chunks: Vec<ListChunk>,
+    /// Steps left before a list that outgrew its bound is recorded again.
+    skip: u32,
 }
 
 /// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK: those of the
@@ -166,6 +183,8 @@ pub struct NeighborList {
 pub struct ListChunk {
     offsets: Vec<u32>,
     j: Vec<u32>,
+    /// Not recorded this step (`push` does nothing).
+    off: bool,
 }
 
 impl ListChunk {
@@ -175,7 +194,11 @@ impl ListChunk {
         self.j.clear();
     }
     /// Ends the current particle with neighbours `js` (empty for one not gathered).
+    #[inline(always)]
     pub fn push(&mut self, js: &[u32]) {
+        if self.off {
+            return;
+        }
         self.j.extend_from_slice(js);
         self.offsets.push(self.j.len() as u32);
     }
@@ -183,27 +206,41 @@ impl ListChunk {
 
 impl NeighborList {
     /// `n` empty chunks for the density pass to fill, reusing the buffers of the
-    /// last step's list (no allocation once the sizes have settled).
+    /// last step's list (no allocation once the sizes have settled); chunks that
+    /// record nothing while a list that outgrew its bound waits for its retry.
     pub fn take_chunks(&mut self, n: usize) -> Vec<ListChunk> {
         let mut chunks = std::mem::take(&mut self.chunks);
         self.generation = 0;
+        let off = self.skip > 0;
+        self.skip = self.skip.saturating_sub(1);
         chunks.resize_with(n, ListChunk::default);
         for c in &mut chunks {
             c.clear();
+            c.off = off;
         }
         chunks
     }
 
-    /// Keeps the chunks of this step's density pass for `grid`, unless they hold
-    /// more than LIST_MAX_ENTRIES indices.
+    /// Keeps the chunks of this step's density pass for `grid`, unless they were
+    /// not recorded or hold more than LIST_MAX_ENTRIES indices (then the next
+    /// LIST_RETRY_STEPS steps record none).
     pub fn store(&mut self, grid: &CellTable, chunks: Vec<ListChunk>) {
+        self.store_within(grid, chunks, *LIST_MAX_ENTRIES);
+    }
+
+    fn store_within(&mut self, grid: &CellTable, chunks: Vec<ListChunk>, max_entries: usize) {
+        if chunks.iter().any(|c| c.off) {
+            self.chunks = chunks;
+            return;
+        }
         let entries: usize = chunks.iter().map(|c| c.j.len()).sum();
-        if entries <= LIST_MAX_ENTRIES {
+        if entries <= max_entries {
             self.generation = grid.generation;
             self.chunks = chunks;
         } else {
             self.generation = 0;
             self.chunks = Vec::new();
+            self.skip = LIST_RETRY_STEPS;
         }
     }
 
@@ -359,7 +396,7 @@ impl Candidates {
     /// a multiply and an add), eight lanes at a time, and the compaction by
     /// left-packing (`compact_avx2`).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt")]
     unsafe fn distances_avx2(&mut self, pr: &Params, pi: [f32; 4]) {
         self.differences(pr, pi);
         let n = self.j.len();
@@ -380,7 +417,7 @@ impl Candidates {
     /// The same operations as `differences` (pi − x, then dx² + dy² + dz² in
     /// that order), so the same bits; returns the count.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt")]
     unsafe fn neighbours_avx2(&mut self, pr: &Params, pi: [f32; 4]) -> usize {
         use std::arch::x86_64::*;
         let n = self.j.len();
@@ -516,7 +553,7 @@ static LEFT_PACK: [[u32; 8]; 256] = {
 /// neighbours are overwritten by the next store). Same selection as the scalar
 /// `r2 < support2` (false for NaN, as _CMP_LT_OQ).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,popcnt")]
 unsafe fn compact_avx2(r2: &[f32], support2: f32, hits: &mut [u32], hit_r2: &mut [f32]) -> usize {
     use std::arch::x86_64::*;
     let n = r2.len();
@@ -625,14 +662,19 @@ fn cell_key(pr: &Params, p: &[f32; 4], phase: u32) -> u32 {
 
 pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
     let n = st.len();
-    let mut keys: Vec<(u32, u32)> = st
-        .pos
+    let (mut keys, mut perm) = (
+        std::mem::take(&mut grid.keys),
+        std::mem::take(&mut grid.perm),
+    );
+    st.pos
         .par_iter()
         .enumerate()
         .map(|(i, p)| (cell_key(pr, p, st.phase[i]), i as u32))
-        .collect();
+        .collect_into_vec(&mut keys);
     keys.par_sort_unstable();
-    let perm: Vec<usize> = keys.iter().map(|k| k.1 as usize).collect();
+    keys.par_iter()
+        .map(|k| k.1 as usize)
+        .collect_into_vec(&mut perm);
     // Every sorted field the scene holds (crate::fields); the others are
     // recomputed after the sort.
     let held = Held::of_state(st);
@@ -661,6 +703,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
             grid.fluid[c as usize] = true;
         }
     }
+    (grid.keys, grid.perm) = (keys, perm);
 }
 
 #[cfg(test)]
@@ -725,6 +768,37 @@ mod tests {
             let listed = visits(|f| for_each_listed(&pr, pos, &grid, &list, i, f));
             assert_eq!(walk, listed, "{scene}: fallback sweep");
         }
+    }
+
+    /// A list over its bound is dropped and not recorded again for
+    /// LIST_RETRY_STEPS steps (the passes sweep the cells meanwhile, with the same
+    /// neighbours), then recorded again.
+    #[test]
+    fn a_list_over_its_bound_waits_before_it_is_recorded_again() {
+        let (pr, mut st, grid) = jittered("dam_break_3d");
+        let fluid = (0..st.len()).find(|&i| !pr.is_wall(st.phase[i])).unwrap();
+        let mut list = NeighborList::default();
+        let chunks = list.take_chunks(st.active().div_ceil(LIST_CHUNK));
+        let mut filled = chunks;
+        for (c, chunk) in filled.iter_mut().enumerate() {
+            for i in c * LIST_CHUNK..((c + 1) * LIST_CHUNK).min(st.active()) {
+                with_neighbors(&pr, &st.pos, &grid, i, |js, _| chunk.push(js));
+            }
+        }
+        list.store_within(&grid, filled, 10);
+        assert!(
+            list.of(&grid, fluid).is_none(),
+            "a list over its bound was kept"
+        );
+        for step in 0..LIST_RETRY_STEPS {
+            super::super::density::run(&pr, &mut st, &grid, &mut list);
+            assert!(
+                list.of(&grid, fluid).is_none(),
+                "recorded again at step {step}"
+            );
+        }
+        super::super::density::run(&pr, &mut st, &grid, &mut list);
+        assert!(list.of(&grid, fluid).is_some(), "never recorded again");
     }
 
     /// A walk from inside a neighbour callback (the thread's candidate cache is

@@ -90,138 +90,162 @@ fn sweep<
     // pair only in the δ sweeps.
     let marrone = active(pr, "marrone_viscosity");
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
-    st.acc[..n]
-        .par_iter_mut()
-        .zip(st.acc_b[..n].par_iter_mut())
-        .enumerate()
-        .for_each(|(i, (acc, acc_b))| {
-            let ph_i = phase[i];
-            if pr.is_wall(ph_i) {
+    let (acc, acc_b) = (&mut st.acc[..n], &mut st.acc_b[..n]);
+    accelerations(pr, phase, mass, acc, acc_b, |i| {
+        let ph_i = phase[i];
+        let mat_i = pr.phase(ph_i);
+        let (rho_i, p_i, m_i) = (rho[i], p[i], mass[i]);
+        let v_i = vel[i];
+        let vol_i = vol[i];
+        let pb = pr.flow.background_pressure;
+        let mut f = [0.0f32; 3];
+        let mut fb = [0.0f32; 3];
+        let mut heating = 0.0f32;
+        let alpha_i = if IV {
+            terms::interface_viscosity_alpha(pr, surface[i][S_DELTA])
+        } else {
+            0.0
+        };
+        let gamma_i = if DF { cont[i][1] } else { 1.0 };
+        let alpha_sf_i = if SF {
+            terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][H_TEMPERATURE])
+        } else {
+            0.0
+        };
+        for_each_listed(pr, pos, grid, list, i, |j, d, r2| {
+            if r2 <= 0.0 {
                 return;
             }
-            let mat_i = pr.phase(ph_i);
-            let (rho_i, p_i, m_i) = (rho[i], p[i], mass[i]);
-            let v_i = vel[i];
-            let vol_i = vol[i];
-            let pb = pr.flow.background_pressure;
-            let mut f = [0.0f32; 3];
-            let mut fb = [0.0f32; 3];
-            let mut heating = 0.0f32;
-            let alpha_i = if IV {
-                terms::interface_viscosity_alpha(pr, surface[i][S_DELTA])
+            let r = r2.sqrt();
+            let dwdr = kernel::dw(pr, r);
+            let ph_j = phase[j];
+            let mat_j = pr.phase(ph_j);
+            let wall = mat_j.kind >= KIND_WALL;
+            let p_j = p[j];
+            let (rho_j, m_j, vol_j) = if wall {
+                let rho_j = mat_i.rho0 + p_j / mat_i.c2;
+                (rho_j, m_i, m_i / rho_j)
             } else {
-                0.0
+                (rho[j], mass[j], vol[j])
             };
-            let gamma_i = if DF { cont[i][1] } else { 1.0 };
-            let alpha_sf_i = if SF {
-                terms::solid_fluid_viscosity_alpha(pr, ph_i, heat[i][H_TEMPERATURE])
+            let vv = vol_i * vol_i + vol_j * vol_j;
+            // The pair terms, in the order of backend::terms::PAIR_TERMS:
+            // F22 (23)'s pressure and viscosity, or (DF) R18's pressure
+            // and (DF and the scene's option) R18's viscosity.
+            let fp = if DF {
+                0.0
             } else {
-                0.0
+                terms::pressure(p_i, p_j, rho_i, rho_j, dwdr, r)
             };
-            for_each_listed(pr, pos, grid, list, i, |j, d, r2| {
-                if r2 <= 0.0 {
-                    return;
-                }
-                let r = r2.sqrt();
-                let dwdr = kernel::dw(pr, r);
-                let ph_j = phase[j];
-                let mat_j = pr.phase(ph_j);
-                let wall = mat_j.kind >= KIND_WALL;
-                let p_j = p[j];
-                let (rho_j, m_j, vol_j) = if wall {
-                    let rho_j = mat_i.rho0 + p_j / mat_i.c2;
-                    (rho_j, m_i, m_i / rho_j)
-                } else {
-                    (rho[j], mass[j], vol[j])
-                };
-                let vv = vol_i * vol_i + vol_j * vol_j;
-                // The pair terms, in the order of backend::terms::PAIR_TERMS:
-                // F22 (23)'s pressure and viscosity, or (DF) R18's pressure
-                // and (DF and the scene's option) R18's viscosity.
-                let fp = if DF {
-                    0.0
-                } else {
-                    terms::pressure(p_i, p_j, rho_i, rho_j, dwdr, r)
-                };
-                let eta_ij = eta_pair.get(ph_i, ph_j);
-                let fv = if DF && marrone {
-                    0.0
-                } else {
-                    terms::viscosity(eta_ij, dwdr, r)
-                };
-                let v_j = vel[j];
+            let eta_ij = eta_pair.get(ph_i, ph_j);
+            let fv = if DF && marrone {
+                0.0
+            } else {
+                terms::viscosity(eta_ij, dwdr, r)
+            };
+            let v_j = vel[j];
+            for a in 0..3 {
+                let u = v_i[a] - v_j[a];
+                f[a] += vv * (fp * d[a] + fv * u);
+            }
+            if DF {
+                let gamma_j = if wall { 1.0 } else { cont[j][1] };
+                let s = terms::shepard_pressure(
+                    m_i, m_j, rho_i, rho_j, p_i, p_j, gamma_i, gamma_j, dwdr, r,
+                );
                 for a in 0..3 {
-                    let u = v_i[a] - v_j[a];
-                    f[a] += vv * (fp * d[a] + fv * u);
+                    f[a] += s * d[a];
                 }
-                if DF {
-                    let gamma_j = if wall { 1.0 } else { cont[j][1] };
-                    let s = terms::shepard_pressure(
-                        m_i, m_j, rho_i, rho_j, p_i, p_j, gamma_i, gamma_j, dwdr, r,
-                    );
-                    for a in 0..3 {
-                        f[a] += s * d[a];
-                    }
+            }
+            if DF && marrone {
+                let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                let s =
+                    terms::marrone_viscosity(pr, m_i, m_j, rho_i, rho_j, eta_ij, u, d, r2, dwdr, r);
+                for a in 0..3 {
+                    f[a] += s * d[a];
                 }
-                if DF && marrone {
-                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
-                    let s = terms::marrone_viscosity(
-                        pr, m_i, m_j, rho_i, rho_j, eta_ij, u, d, r2, dwdr, r,
-                    );
-                    for a in 0..3 {
-                        f[a] += s * d[a];
-                    }
+            }
+            if BG {
+                let fbg = terms::background_pressure(pb, dwdr, r);
+                for a in 0..3 {
+                    fb[a] += vv * (fbg * d[a]);
                 }
-                if BG {
-                    let fbg = terms::background_pressure(pb, dwdr, r);
-                    for a in 0..3 {
-                        fb[a] += vv * (fbg * d[a]);
-                    }
+            }
+            if IV && !wall {
+                let alpha =
+                    (alpha_i + terms::interface_viscosity_alpha(pr, surface[j][S_DELTA])) * 0.5;
+                let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                let s = terms::interface_viscosity(
+                    pr, m_i, m_j, rho_i, rho_j, mat_i.c2, mat_j.c2, u, d, r2, dwdr, alpha,
+                );
+                for a in 0..3 {
+                    f[a] += s * d[a];
                 }
-                if IV && !wall {
-                    let alpha =
-                        (alpha_i + terms::interface_viscosity_alpha(pr, surface[j][S_DELTA])) * 0.5;
-                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
-                    let s = terms::interface_viscosity(
-                        pr, m_i, m_j, rho_i, rho_j, mat_i.c2, mat_j.c2, u, d, r2, dwdr, alpha,
-                    );
-                    for a in 0..3 {
-                        f[a] += s * d[a];
-                    }
+            }
+            if SF {
+                let alpha_j = if wall {
+                    alpha_sf_i
+                } else {
+                    terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][H_TEMPERATURE])
+                };
+                let alpha = (alpha_sf_i + alpha_j) * 0.5;
+                let c2_j = if wall { mat_i.c2 } else { mat_j.c2 };
+                let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
+                let s = terms::solid_fluid_viscosity(
+                    pr, m_i, m_j, rho_i, rho_j, mat_i.c2, c2_j, u, d, r2, dwdr, alpha,
+                );
+                for a in 0..3 {
+                    f[a] += s * d[a];
                 }
-                if SF {
-                    let alpha_j = if wall {
-                        alpha_sf_i
-                    } else {
-                        terms::solid_fluid_viscosity_alpha(pr, ph_j, heat[j][H_TEMPERATURE])
-                    };
-                    let alpha = (alpha_sf_i + alpha_j) * 0.5;
-                    let c2_j = if wall { mat_i.c2 } else { mat_j.c2 };
-                    let u = [v_i[0] - v_j[0], v_i[1] - v_j[1], v_i[2] - v_j[2]];
-                    let s = terms::solid_fluid_viscosity(
-                        pr, m_i, m_j, rho_i, rho_j, mat_i.c2, c2_j, u, d, r2, dwdr, alpha,
-                    );
-                    for a in 0..3 {
-                        f[a] += s * d[a];
-                    }
+            }
+            if VH {
+                let (w, share) = if wall {
+                    (mat_j.velocity.to_array(), 1.0)
+                } else {
+                    (v_j, 0.5)
+                };
+                heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
+            }
+            if BR && wall && r < pr.flow.barrier_radius {
+                let w = mat_j.velocity;
+                let s = terms::barrier(pr, xyz(v_i), [w.x, w.y, w.z], d, r);
+                for a in 0..3 {
+                    f[a] += s * d[a];
                 }
-                if VH {
-                    let (w, share) = if wall {
-                        (mat_j.velocity.to_array(), 1.0)
-                    } else {
-                        (v_j, 0.5)
-                    };
-                    heating -= terms::viscous_heating(v_i, v_j, w, share, vv, fv);
-                }
-                if BR && wall && r < pr.flow.barrier_radius {
-                    let w = mat_j.velocity;
-                    let s = terms::barrier(pr, xyz(v_i), [w.x, w.y, w.z], d, r);
-                    for a in 0..3 {
-                        f[a] += s * d[a];
-                    }
-                }
-            });
-            let g = pr.flow.gravity;
+            }
+        });
+        Sums { f, fb, heating }
+    });
+}
+
+/// What the sweep sums over one particle's neighbours: the force, the
+/// background-pressure force and the viscous heating.
+pub(super) struct Sums {
+    pub f: [f32; 3],
+    pub fb: [f32; 3],
+    pub heating: f32,
+}
+
+/// For every fluid particle i (walls are skipped), `sums(i)` divided by m_i into
+/// acc (with gravity; heating in acc.w) and acc_b: the write both sweeps end with.
+pub(super) fn accelerations(
+    pr: &Params,
+    phase: &[u32],
+    mass: &[f32],
+    acc: &mut [[f32; 4]],
+    acc_b: &mut [[f32; 4]],
+    sums: impl Fn(usize) -> Sums + Sync,
+) {
+    let g = pr.flow.gravity;
+    acc.par_iter_mut()
+        .zip(acc_b.par_iter_mut())
+        .enumerate()
+        .for_each(|(i, (acc, acc_b))| {
+            if pr.is_wall(phase[i]) {
+                return;
+            }
+            let Sums { f, fb, heating } = sums(i);
+            let m_i = mass[i];
             *acc = [
                 f[0] / m_i + g[0],
                 f[1] / m_i + g[1],

@@ -17,6 +17,7 @@
 //! the scalar sweep skips, adds +0 instead: a sum that starts at +0 never becomes
 //! −0, so adding +0 leaves its bits as they are.
 
+use super::forces::{accelerations, Sums};
 use super::neighbors::{with_listed, CellTable, NeighborList};
 use super::terms;
 use crate::backend::terms::{active, PAIR_TERMS};
@@ -74,46 +75,37 @@ pub fn run(
         })
         .collect();
     let (pos, vel, mass, phase) = (&st.pos, &st.vel, &st.mass, &st.phase);
-    let g = pr.flow.gravity;
-    st.acc[..n]
-        .par_iter_mut()
-        .zip(st.acc_b[..n].par_iter_mut())
-        .enumerate()
-        .for_each(|(i, (acc, acc_b))| {
-            let ph_i = phase[i];
-            if pr.is_wall(ph_i) {
-                return;
-            }
-            let m_i = mass[i];
-            let (f, fb) = with_listed(pr, pos, grid, list, i, |js| {
-                let p = Pair {
-                    pr,
-                    pos,
-                    vel,
-                    records: &records,
-                    mass,
-                    phase,
-                    eta: &eta[ph_i as usize],
-                    wall_velocity: &wall_velocity,
-                };
-                // SAFETY: `applies` checked that this CPU has AVX2.
-                unsafe {
-                    match (bg, br) {
-                        (false, false) => p.sums::<false, false>(i, js),
-                        (false, true) => p.sums::<false, true>(i, js),
-                        (true, false) => p.sums::<true, false>(i, js),
-                        (true, true) => p.sums::<true, true>(i, js),
-                    }
+    let (acc, acc_b) = (&mut st.acc[..n], &mut st.acc_b[..n]);
+    accelerations(pr, phase, mass, acc, acc_b, |i| {
+        with_listed(pr, pos, grid, list, i, |js| {
+            let p = Pair {
+                pr,
+                pos,
+                vel,
+                records: &records,
+                mass,
+                phase,
+                eta: &eta[phase[i] as usize],
+                wall_velocity: &wall_velocity,
+            };
+            // SAFETY: `applies` checked that this CPU has AVX2.
+            let (f, fb) = unsafe {
+                match (bg, br) {
+                    (false, false) => p.sums::<false, false>(i, js),
+                    (false, true) => p.sums::<false, true>(i, js),
+                    (true, false) => p.sums::<true, false>(i, js),
+                    (true, true) => p.sums::<true, true>(i, js),
                 }
-            });
-            *acc = [
-                f[0] / m_i + g[0],
-                f[1] / m_i + g[1],
-                f[2] / m_i + g[2],
-                0.0 / m_i,
-            ];
-            *acc_b = [fb[0] / m_i, fb[1] / m_i, fb[2] / m_i, 0.0];
-        });
+            };
+            // No viscous heating here: its sum stays +0, as in the scalar sweep.
+            let xyz = |v: [f32; 4]| [v[0], v[1], v[2]];
+            Sums {
+                f: xyz(f),
+                fb: xyz(fb),
+                heating: 0.0,
+            }
+        })
+    });
 }
 
 /// What the pair sums of one particle read.

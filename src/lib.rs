@@ -11,6 +11,7 @@ pub mod diagnostics;
 pub mod error;
 pub mod fields;
 pub mod gpu_layout;
+pub mod host;
 pub mod inspect;
 pub mod kernel;
 pub mod lanes;

@@ -113,14 +113,6 @@ pub fn memory_estimate(m: &Model, particles: f64) -> f64 {
     particles * per_particle as f64 + m.n_cells() as f64 * BYTES_PER_CELL as f64
 }
 
-/// Memory this machine has free, from /proc/meminfo (None where unknown).
-pub fn available_memory() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0)
-}
-
 /// A shape's point or direction (`dim` components) as a DVec3, 0 beyond `dim`
 /// like the lattice sites.
 fn vec3(v: &[f64]) -> DVec3 {
@@ -280,7 +272,7 @@ fn wall_phase_at(m: &Model, scene: &SceneFile, x: [f64; 3]) -> Option<usize> {
 pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     let sites = site_count(m);
     let bytes = memory_estimate(m, sites);
-    if let Some(avail) = available_memory() {
+    if let Some(avail) = crate::host::available_memory() {
         if bytes > 0.8 * avail {
             return Err(InputError::new(
                 &m.file,

@@ -153,13 +153,6 @@ fn scene_of_size(s: &BenchScene, target: f64) -> Result<Loaded, SpatterError> {
     Ok(l)
 }
 
-/// Memory this machine has free (Linux MemAvailable), in bytes.
-fn host_available() -> Option<f64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0)
-}
-
 fn lost(e: crate::backend::DeviceLost) -> SpatterError {
     SpatterError::Runtime(e.to_string())
 }
@@ -333,7 +326,7 @@ fn too_big(l: &Loaded, rate: Option<f64>, steps: u32) -> Option<String> {
     let n = l.state.len() as f64;
     // The CPU backend holds the state, its reorder scratch and the initial copy.
     let need = 2.0 * setup::memory_estimate(&l.model, n);
-    if let Some(free) = host_available() {
+    if let Some(free) = crate::host::available_memory() {
         if need > free {
             return Some(format!(
                 "needs {:.1} GiB, {:.1} GiB free",

@@ -157,7 +157,7 @@ pub const LIST_CHUNK: usize = 1024;
 /// later passes sweep the cells themselves (at 1e7 particles of dam_break_3d the
 /// list takes 2.6 GB and halves the forces pass).
 static LIST_MAX_ENTRIES: std::sync::LazyLock<usize> =
-    std::sync::LazyLock::new(|| match crate::setup::available_memory() {
+    std::sync::LazyLock::new(|| match crate::host::available_memory() {
         Some(free) => (free / 2.0 / 4.0) as usize,
         None => 1 << 27,
     });

@@ -226,16 +226,15 @@ fn ensure_runtime_dir() {}
 fn main() -> ExitCode {
     ensure_runtime_dir();
     let cli = Cli::parse();
-    // The command runs on a thread of the rayon pool, which then takes part in
-    // every parallel pass: with the pool beside the main thread, its idle workers
-    // spin (sched_yield) while the main thread does the host's serial work, three
+    // The main thread is worker 0 of the rayon pool, so it takes part in every
+    // parallel pass. With the pool beside it, the pool's idle workers spun
+    // (sched_yield) while the main thread did the host's serial work: three
     // threads on two cores, and the README's line melt spent 45% of its samples
     // in the scheduler.
-    let pool = rayon::ThreadPoolBuilder::new().build();
-    let result = match pool {
-        Ok(pool) => pool.install(|| dispatch(cli)),
-        Err(_) => dispatch(cli),
-    };
+    let _ = rayon::ThreadPoolBuilder::new()
+        .use_current_thread()
+        .build_global();
+    let result = dispatch(cli);
     match result {
         Ok(code) => code,
         Err(SpatterError::Input(e)) => {

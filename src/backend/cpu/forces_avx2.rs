@@ -9,9 +9,8 @@
 //! eight lanes share that wait. The kernel and the terms are the same functions
 //! (`kernel::dw`, `terms::pressure`, `terms::viscosity`,
 //! `terms::background_pressure`, `terms::barrier`, generic over `Lane`), so each
-//! lane does the
-//! scalar sweep's operations; the eight contributions are then added to the sums
-//! one by one in the list's order. So the bits are the scalar sweep's, and the
+//! lane does the scalar sweep's operations; the eight contributions are then
+//! added to the sums one by one in the list's order. So the bits are the scalar sweep's, and the
 //! GPU twin's (`eight_wide_forces_match_the_scalar_sweep`, and the bit-match
 //! suite on lavapipe). A lane past the list's end, or a neighbour at r = 0, which
 //! the scalar sweep skips, adds +0 instead: a sum that starts at +0 never becomes
@@ -65,6 +64,8 @@ pub fn run(
         .into_par_iter()
         .map(|j| {
             let ph = st.phase[j];
+            // The gathers from the per-phase tables below read index ph unchecked.
+            assert!((ph as usize) < MAX_PHASES, "particle {j}: phase {ph}");
             let wall = if pr.is_wall(ph) { WALL_BIT } else { 0 };
             [
                 st.rho[j],

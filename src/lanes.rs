@@ -43,7 +43,9 @@ impl Lane for f32 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use avx::{AVX2, F8};
+pub use avx::AVX2;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::F8;
 
 #[cfg(target_arch = "x86_64")]
 mod avx {
@@ -57,17 +59,18 @@ mod avx {
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("popcnt")
     });
 
-    /// Eight f32 in one AVX register. Only code compiled with
-    /// `#[target_feature(enable = "avx2")]` makes one (from an intrinsic), so every
-    /// operation below runs where AVX is present; each is `#[inline(always)]`
-    /// so that it is compiled into that caller with its features.
+    /// Eight f32 in one AVX register. Private to the crate, whose code makes
+    /// one only inside `#[target_feature(enable = "avx2")]` functions reached
+    /// after the `AVX2` check (`F8::splat` and the operators are safe to call
+    /// but execute AVX instructions); each operation is `#[inline(always)]` so
+    /// that it is compiled into that caller with its features.
     #[derive(Clone, Copy)]
-    pub struct F8(pub __m256);
+    pub(crate) struct F8(pub(crate) __m256);
 
     impl F8 {
         /// The register as eight lanes (for tests and scalar tails).
         #[inline(always)]
-        pub fn to_array(self) -> [f32; 8] {
+        pub(crate) fn to_array(self) -> [f32; 8] {
             // SAFETY: __m256 and [f32; 8] have the same size, any bits are valid.
             unsafe { std::mem::transmute::<__m256, [f32; 8]>(self.0) }
         }

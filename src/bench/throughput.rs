@@ -91,7 +91,8 @@ pub struct BenchRow {
     /// (setup::memory_estimate).
     pub bytes_per_particle: f64,
     /// The CPU backend's neighbour list on top (cpu/neighbors.rs `NeighborList`:
-    /// 4 bytes per fluid pair and per particle), None on the GPU, which keeps none.
+    /// 4 bytes per fluid pair, per fluid particle for itself, and per particle),
+    /// None on the GPU, which keeps none.
     pub list_bytes_per_particle: Option<f64>,
     pub pass_ms: Vec<(String, f64)>,
 }
@@ -204,7 +205,7 @@ fn measure(
         list_bytes_per_particle: backend
             .describe()
             .starts_with("cpu")
-            .then(|| 4.0 * (pairs as f64 + n as f64) / n as f64),
+            .then(|| 4.0 * (pairs as f64 + fluid as f64 + n as f64) / n as f64),
         pass_ms: Vec::new(),
     })
 }

@@ -52,6 +52,7 @@ pub fn run(
     list: &NeighborList,
     eta: &[[f32; MAX_PHASES]; MAX_PHASES],
 ) {
+    assert!(*AVX2, "the eight-wide forces sweep needs AVX2 (`applies`)");
     let (bg, br) = (active(pr, "background_pressure"), active(pr, "barrier"));
     // Each phase's wall velocity (the barrier's U_wall), one table per axis.
     let wall_velocity: [[f32; MAX_PHASES]; 3] =
@@ -60,7 +61,10 @@ pub fn run(
     // What a pair reads of its neighbour besides position and velocity, packed in
     // one 16-byte record so that eight of them load and transpose as a block:
     // ρ, p, V = m/ρ (the scalar sweep's division) and the phase with the wall bit.
-    let records: Vec<[f32; 4]> = (0..st.pos.len())
+    // (Into the last step's array: a fresh one would be mapped and cleared page
+    // by page, 160 MB a step at 1e7 particles.)
+    let mut records = RECORDS.with(|r| r.take());
+    (0..st.pos.len())
         .into_par_iter()
         .map(|j| {
             let ph = st.phase[j];
@@ -74,7 +78,7 @@ pub fn run(
                 f32::from_bits(ph | wall),
             ]
         })
-        .collect();
+        .collect_into_vec(&mut records);
     let (pos, vel, mass, phase) = (&st.pos, &st.vel, &st.mass, &st.phase);
     let (acc, acc_b) = (&mut st.acc[..n], &mut st.acc_b[..n]);
     accelerations(pr, phase, mass, acc, acc_b, |i| {
@@ -107,6 +111,12 @@ pub fn run(
             }
         })
     });
+    RECORDS.with(|r| r.replace(records));
+}
+
+thread_local! {
+    /// The neighbour records of the last sweep, whose memory the next reuses.
+    static RECORDS: std::cell::RefCell<Vec<[f32; 4]>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// What the pair sums of one particle read.

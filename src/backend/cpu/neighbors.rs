@@ -151,18 +151,20 @@ pub fn with_neighbors<R>(
 /// Particles per chunk of the neighbour list (one parallel task each).
 pub const LIST_CHUNK: usize = 1024;
 
-/// Most neighbour indices the list holds: half the memory this machine had free
-/// when the first list was stored (4 bytes an index), or 2^27 indices (512 MiB)
-/// where that is unknown. A step that would need more records none, and its
-/// later passes sweep the cells themselves (at 1e7 particles of dam_break_3d the
-/// list takes 2.6 GB and saves 27% of the forces pass).
-static LIST_MAX_ENTRIES: std::sync::LazyLock<usize> =
-    std::sync::LazyLock::new(|| match crate::host::available_memory() {
+/// Most neighbour indices a list holds: half the memory this machine has free
+/// when the list is first taken, before anything is recorded in it (4 bytes an
+/// index), or 2^27 indices (512 MiB) where that is unknown. A step that records
+/// more keeps none (the bound is checked after that step), and the passes sweep
+/// the cells themselves; at 1e7 particles of dam_break_3d the list takes 2.6 GB
+/// and saves 27% of the forces pass.
+fn list_bound() -> usize {
+    match crate::host::available_memory() {
         Some(free) => (free / 2.0 / 4.0) as usize,
         None => 1 << 27,
-    });
+    }
+}
 
-/// Steps a list that outgrew LIST_MAX_ENTRIES is not recorded for before the
+/// Steps a list that outgrew its bound is not recorded for before the
 /// next try (recording one only to drop it doubles the density pass's cost).
 const LIST_RETRY_STEPS: u32 = 100;
 
@@ -175,6 +177,8 @@ pub struct NeighborList {
     chunks: Vec<ListChunk>,
     /// Steps left before a list that outgrew its bound is recorded again.
     skip: u32,
+    /// `list_bound()`, read when the list is first taken.
+    max_entries: Option<usize>,
 }
 
 /// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK: those of the
@@ -211,6 +215,7 @@ impl NeighborList {
     pub fn take_chunks(&mut self, n: usize) -> Vec<ListChunk> {
         let mut chunks = std::mem::take(&mut self.chunks);
         self.generation = 0;
+        self.max_entries.get_or_insert_with(list_bound);
         let off = self.skip > 0;
         self.skip = self.skip.saturating_sub(1);
         chunks.resize_with(n, ListChunk::default);
@@ -222,10 +227,11 @@ impl NeighborList {
     }
 
     /// Keeps the chunks of this step's density pass for `grid`, unless they were
-    /// not recorded or hold more than LIST_MAX_ENTRIES indices (then the next
+    /// not recorded or hold more indices than its bound (then the next
     /// LIST_RETRY_STEPS steps record none).
     pub fn store(&mut self, grid: &CellTable, chunks: Vec<ListChunk>) {
-        self.store_within(grid, chunks, *LIST_MAX_ENTRIES);
+        let max = *self.max_entries.get_or_insert_with(list_bound);
+        self.store_within(grid, chunks, max);
     }
 
     fn store_within(&mut self, grid: &CellTable, chunks: Vec<ListChunk>, max_entries: usize) {

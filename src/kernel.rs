@@ -14,9 +14,10 @@ fn p5<R: Lane>(t: R) -> R {
     t * t * t * t * t
 }
 
-/// W(r) for the kernel chosen in `params.kernel.kind`.
+/// W(r) for the kernel chosen in `params.kernel.kind`, on one distance or on
+/// eight (`Lane`).
 #[inline(always)]
-pub fn w(pr: &Params, r: f32) -> f32 {
+pub fn w<R: Lane>(pr: &Params, r: R) -> R {
     let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
     match pr.kernel.kind {
         0 => w_quintic(sigma, h_inv, r),
@@ -98,19 +99,13 @@ fn sum_in_order(r2: &[f32], w: impl Fn(f32) -> f32) -> f32 {
 unsafe fn sum_w_avx2(pr: &Params, r2: &[f32]) -> f32 {
     use crate::lanes::F8;
     use std::arch::x86_64::{_mm256_loadu_ps, _mm256_sqrt_ps};
-    let (sigma, h_inv) = (pr.kernel.sigma, pr.kernel.inv_h);
-    let kernel8 = |r: F8| match pr.kernel.kind {
-        0 => w_quintic(sigma, h_inv, r),
-        1 => w_wendland_c2(sigma, h_inv, r),
-        _ => w_cubic(sigma, h_inv, r),
-    };
     let mut sum = 0.0f32;
     let blocks = r2.chunks_exact(8);
     let tail = blocks.remainder();
     for block in blocks {
         // SAFETY: the block holds eight f32; AVX is enabled here.
         let x = unsafe { _mm256_loadu_ps(block.as_ptr()) };
-        let values = kernel8(F8(_mm256_sqrt_ps(x))).to_array();
+        let values = w(pr, F8(_mm256_sqrt_ps(x))).to_array();
         for v in values {
             sum += v;
         }

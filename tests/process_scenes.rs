@@ -222,6 +222,30 @@ fn binder_scenes_validate_and_their_check_keys_exit_2() {
         let text = std::fs::read_to_string(&scene).unwrap();
         assert!(text.contains(&format!("velocity = [0.0, {v}]")), "{speed}");
     }
+    // The full-size 3D scenes (GPU jobs): F22's box, spacing and gas, the
+    // same drop speeds; the 10 m/s one takes the 1 m/s run's figures by --set.
+    for (speed, v) in [("1", "-1.0"), ("10", "-10.0"), ("50", "-50.0")] {
+        let scene = common::scene_at(&format!("bjt/binder_{speed}ms"));
+        let out = common::spatter(&["validate", &scene]);
+        let (o, e) = common::text(&out);
+        assert_eq!(out.status.code(), Some(0), "{speed}: {o}{e}");
+        assert!(!o.contains("warning"), "{speed}: {o}");
+        assert!(o.contains("particles: 4939704"), "{speed}: {o}");
+        assert!(o.contains("337 grains"), "{speed}: {o}");
+        assert!(o.contains("on one H100"), "{speed}: {o}");
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert!(text.contains(&format!("velocity = [0.0, 0.0, {v}]")), "{speed}");
+    }
+    let ten = common::scene_at("bjt/binder_10ms");
+    let out = common::spatter(&[
+        "validate",
+        &ten,
+        "--set",
+        "check.penetration_below=1e-6",
+        "--set",
+        "check.spread_above=7e-5",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{:?}", common::text(&out));
     // The 10 m/s check holds its run to the 1 m/s run's figures, which that
     // scene's header states.
     let one = std::fs::read_to_string(common::scene_at("bjt/binder_1ms_coarse_2d")).unwrap();

@@ -49,9 +49,8 @@
 //!   boundaries, moving walls and rigid bodies.
 
 use super::integrate::{stamp_if_left, wrap_periodic};
-use super::neighbors::{
-    for_each_neighbor, with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK,
-};
+use super::dfsph_pairs::{for_each_pair, Pair, PairChunk, PairTable};
+use super::neighbors::{with_neighbors, CellTable, ListChunk, NeighborList, LIST_CHUNK};
 use super::reduce::tree_total;
 use crate::backend::schedule::SolverSlot;
 use crate::kernel;
@@ -71,8 +70,9 @@ pub fn boundary_volume(pr: &Params, st: &mut State) {
     }
 }
 
-/// (ρ_i, α_i) of fluid particle i over its neighbours `js` (walk order).
-fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32]) -> (f32, f32) {
+/// (ρ_i, α_i) of fluid particle i over its neighbours `js` (walk order);
+/// its pairs j ≠ i go to `pairs`.
+fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32], pairs: &mut PairChunk) -> (f32, f32) {
     let rho0_i = pr.phase(st.phase[i]).rho0;
     let pi = st.pos[i];
     let (mut sum_f, mut sum_b, mut sq) = (0.0f32, 0.0f32, 0.0f32);
@@ -85,11 +85,18 @@ fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32]) -> (f32, f32) {
             continue;
         }
         let r = r2.sqrt();
+        let dw = if r2 > 0.0 {
+            let dw = kernel::dw(pr, r) / r;
+            pairs.push(Pair { j: j as u32, d, g: dw });
+            dw
+        } else {
+            0.0
+        };
         if pr.is_wall(st.phase[j]) {
             let psi = rho0_i * st.dfsph[j][0];
             sum_b += st.dfsph[j][0] * kernel::w(pr, r);
             if r2 > 0.0 {
-                let f = psi * (kernel::dw(pr, r) / r);
+                let f = psi * dw;
                 for a in 0..3 {
                     g[a] += f * d[a];
                     gb[a] += f * d[a];
@@ -98,7 +105,7 @@ fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32]) -> (f32, f32) {
         } else {
             sum_f += kernel::w(pr, r);
             if r2 > 0.0 {
-                let f = st.mass[j] * (kernel::dw(pr, r) / r);
+                let f = st.mass[j] * dw;
                 for a in 0..3 {
                     g[a] += f * d[a];
                 }
@@ -106,6 +113,7 @@ fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32]) -> (f32, f32) {
             }
         }
     }
+    pairs.end();
     let rho_i = st.mass[i] * sum_f + rho0_i * sum_b;
     let denom = g[0] * (g[0] + gb[0]) + g[1] * (g[1] + gb[1]) + g[2] * (g[2] + gb[2]) + sq;
     let alpha = if denom > 0.0 { rho_i / denom } else { 0.0 };
@@ -113,32 +121,45 @@ fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32]) -> (f32, f32) {
 }
 
 /// `dfsph_factor`: ρ, α (dfsph.x) and p = 0 of every fluid particle; also
-/// records each fluid particle's neighbours for the forces pass.
-pub fn factor(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
+/// records each fluid particle's neighbours for the forces pass and its
+/// pairs for the solves (dfsph_pairs).
+pub fn factor(
+    pr: &Params,
+    st: &mut State,
+    grid: &CellTable,
+    list: &mut NeighborList,
+    table: &mut PairTable,
+) {
     let n = st.active();
     let chunks = list.take_chunks(n.div_ceil(LIST_CHUNK));
+    let pair_chunks = table.take_chunks(n.div_ceil(LIST_CHUNK));
     let s: &State = st;
-    let (out, chunks): (Vec<Vec<(f32, f32)>>, Vec<ListChunk>) = (0..n.div_ceil(LIST_CHUNK))
-        .into_par_iter()
-        .zip(chunks)
-        .map(|(c, mut chunk)| {
-            let range = c * LIST_CHUNK..((c + 1) * LIST_CHUNK).min(n);
-            let values = range
-                .map(|i| {
-                    if pr.is_wall(s.phase[i]) {
-                        chunk.push(&[]);
-                        return (f32::NAN, f32::NAN);
-                    }
-                    with_neighbors(pr, &s.pos, grid, i, |js, _| {
-                        chunk.push(js);
-                        factor_of(pr, s, i, js)
+    type Chunked = (Vec<(f32, f32)>, (ListChunk, PairChunk));
+    let (out, (chunks, pair_chunks)): (Vec<Vec<(f32, f32)>>, (Vec<ListChunk>, Vec<PairChunk>)) =
+        (0..n.div_ceil(LIST_CHUNK))
+            .into_par_iter()
+            .zip(chunks)
+            .zip(pair_chunks)
+            .map(|((c, mut chunk), mut pairs)| -> Chunked {
+                let range = c * LIST_CHUNK..((c + 1) * LIST_CHUNK).min(n);
+                let values = range
+                    .map(|i| {
+                        if pr.is_wall(s.phase[i]) {
+                            chunk.push(&[]);
+                            pairs.end();
+                            return (f32::NAN, f32::NAN);
+                        }
+                        with_neighbors(pr, &s.pos, grid, i, |js, _| {
+                            chunk.push(js);
+                            factor_of(pr, s, i, js, &mut pairs)
+                        })
                     })
-                })
-                .collect();
-            (values, chunk)
-        })
-        .unzip();
+                    .collect();
+                (values, (chunk, pairs))
+            })
+            .unzip();
     list.store(grid, chunks);
+    table.store(grid, pair_chunks);
     for (i, (rho, alpha)) in out.into_iter().flatten().enumerate() {
         if pr.is_wall(st.phase[i]) {
             continue;
@@ -150,15 +171,11 @@ pub fn factor(pr: &Params, st: &mut State, grid: &CellTable, list: &mut Neighbor
 }
 
 /// Dρ_i/Dt over fluid and boundary neighbours.
-fn density_rate(pr: &Params, st: &State, grid: &CellTable, i: usize) -> f32 {
+fn density_rate(pr: &Params, st: &State, grid: &CellTable, table: &PairTable, i: usize) -> f32 {
     let rho0_i = pr.phase(st.phase[i]).rho0;
     let v_i = st.vel[i];
     let mut rate = 0.0f32;
-    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
-        if r2 <= 0.0 {
-            return;
-        }
-        let r = r2.sqrt();
+    for_each_pair(pr, &st.pos, grid, table, i, |j, d, dw| {
         let (u, w) = if pr.is_wall(st.phase[j]) {
             let u = pr.phase(st.phase[j]).velocity;
             ([u[0], u[1], u[2]], rho0_i * st.dfsph[j][0])
@@ -167,28 +184,30 @@ fn density_rate(pr: &Params, st: &State, grid: &CellTable, i: usize) -> f32 {
             ([u[0], u[1], u[2]], st.mass[j])
         };
         let ud = (v_i[0] - u[0]) * d[0] + (v_i[1] - u[1]) * d[1] + (v_i[2] - u[2]) * d[2];
-        rate += w * ud * (kernel::dw(pr, r) / r);
+        rate += w * ud * dw;
     });
     rate
 }
 
 /// The new velocity of fluid particle i after the κ of dfsph.z.
-fn kappa_velocity(pr: &Params, st: &State, grid: &CellTable, i: usize) -> [f32; 4] {
+fn kappa_velocity(
+    pr: &Params,
+    st: &State,
+    grid: &CellTable,
+    table: &PairTable,
+    i: usize,
+) -> [f32; 4] {
     let rho0_i = pr.phase(st.phase[i]).rho0;
     let k_i = st.dfsph[i][2] / st.rho[i];
     let mut dv = [0.0f32; 3];
-    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
-        if r2 <= 0.0 {
-            return;
-        }
-        let r = r2.sqrt();
+    for_each_pair(pr, &st.pos, grid, table, i, |j, d, dw| {
         let s = if pr.is_wall(st.phase[j]) {
             let s_b = rho0_i * st.dfsph[j][0] * k_i;
             s_b + s_b
         } else {
             st.mass[j] * (k_i + st.dfsph[j][2] / st.rho[j])
         };
-        let f = s * (kernel::dw(pr, r) / r);
+        let f = s * dw;
         for a in 0..3 {
             dv[a] += f * d[a];
         }
@@ -214,13 +233,13 @@ fn converged(st: &State, slot: SolverSlot) -> bool {
 
 /// The solve's error (dfsph.y) of every fluid particle: the divergence's
 /// max(Dρ/Dt, 0), or the density's max(ρ + Δt Dρ/Dt − ρ0, 0).
-fn errors(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
+fn errors(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     let s: &State = st;
     let dt = s.sim.dt;
     let out: Vec<(usize, f32)> = fluid(pr, s)
         .into_par_iter()
         .map(|i| {
-            let rate = density_rate(pr, s, grid, i);
+            let rate = density_rate(pr, s, grid, table, i);
             let e = match slot {
                 SolverSlot::Divergence => rate,
                 _ => s.rho[i] + dt * rate - pr.phase(s.phase[i]).rho0,
@@ -237,9 +256,9 @@ fn errors(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
 /// κ = ½ K / Δt² (density; K = Δt² Σκ of the last step) or ½ K / Δt
 /// (divergence; K = Δt Σκ) where the particle is compressed now, else 0, in
 /// dfsph.z (the stage's velocity and error dispatches apply it) and dfsph.w.
-pub fn begin(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
+pub fn begin(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     st.solvers[slot as usize] = st.solvers[slot as usize].reset();
-    errors(pr, st, grid, slot);
+    errors(pr, st, grid, table, slot);
     let dt = st.sim.dt;
     for i in fluid(pr, st) {
         let (stored, scale) = match slot {
@@ -273,14 +292,14 @@ pub fn kappa(pr: &Params, st: &mut State, slot: SolverSlot) {
 }
 
 /// `dfsph_*_velocity`: every fluid velocity after the κ just computed.
-pub fn velocity(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
+pub fn velocity(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     if converged(st, slot) {
         return;
     }
     let s: &State = st;
     let out: Vec<(usize, [f32; 4])> = fluid(pr, s)
         .into_par_iter()
-        .map(|i| (i, kappa_velocity(pr, s, grid, i)))
+        .map(|i| (i, kappa_velocity(pr, s, grid, table, i)))
         .collect();
     for (i, v) in out {
         st.vel[i] = v;
@@ -288,11 +307,11 @@ pub fn velocity(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot)
 }
 
 /// `dfsph_*_error`: the errors at the corrected velocities.
-pub fn error(pr: &Params, st: &mut State, grid: &CellTable, slot: SolverSlot) {
+pub fn error(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     if converged(st, slot) {
         return;
     }
-    errors(pr, st, grid, slot);
+    errors(pr, st, grid, table, slot);
 }
 
 /// The mean error over fluid particles by the GPU's two-level tree.
@@ -332,18 +351,17 @@ pub fn residual(pr: &Params, st: &mut State, slot: SolverSlot) {
 /// g·(x_b − x_i)/ρ_i; the κ_i part is in `kappa_velocity`, this is
 /// Σ_b Ψ_b (g·(x_b − x_i)/ρ_i) ∇W_ib, applied once per step. Without it the
 /// first row above a floor sinks at about g/2 under a hydrostatic κ.
-fn wall_head(pr: &Params, st: &State, grid: &CellTable, i: usize) -> [f32; 3] {
+fn wall_head(pr: &Params, st: &State, grid: &CellTable, table: &PairTable, i: usize) -> [f32; 3] {
     let rho0_i = pr.phase(st.phase[i]).rho0;
     let g = pr.flow.gravity;
     let rho_i = st.rho[i];
     let mut h = [0.0f32; 3];
-    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
-        if r2 <= 0.0 || !pr.is_wall(st.phase[j]) {
+    for_each_pair(pr, &st.pos, grid, table, i, |j, d, dw| {
+        if !pr.is_wall(st.phase[j]) {
             return;
         }
-        let r = r2.sqrt();
         let gd = 0.0 - g[0] * d[0] - g[1] * d[1] - g[2] * d[2];
-        let f = rho0_i * st.dfsph[j][0] * (gd / rho_i) * (kernel::dw(pr, r) / r);
+        let f = rho0_i * st.dfsph[j][0] * (gd / rho_i) * dw;
         for a in 0..3 {
             h[a] += f * d[a];
         }
@@ -353,12 +371,12 @@ fn wall_head(pr: &Params, st: &State, grid: &CellTable, i: usize) -> [f32; 3] {
 
 /// `dfsph_predict`: v* = v + Δt (a − the walls' head), then the mushy-zone
 /// sink v*/(1 + Δt C (1 − f_l)); the divergence solve's store Δt Σκ.
-pub fn predict(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn predict(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable) {
     let dt = st.sim.dt;
     let s: &State = st;
     let heads: Vec<(usize, [f32; 3])> = fluid(pr, s)
         .into_par_iter()
-        .map(|i| (i, wall_head(pr, s, grid, i)))
+        .map(|i| (i, wall_head(pr, s, grid, table, i)))
         .collect();
     for (i, b) in heads {
         st.dfsph_warm[i][1] = dt * st.dfsph[i][3];

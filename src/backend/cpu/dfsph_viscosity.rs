@@ -47,7 +47,8 @@
 //!   gives about 2e-5 m/s² at Δx = 0.8 µm, nothing against a 200 m/s impact,
 //!   so J22's value is not the scene's (issue 30's note).
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::dfsph_pairs::{for_each_pair, PairTable};
+use super::neighbors::{for_each_neighbor, CellTable, LIST_CHUNK};
 use super::reduce::tree_total;
 use super::terms::pair_viscosity;
 use crate::backend::schedule::SolverSlot;
@@ -64,11 +65,11 @@ const Q: usize = 2;
 const DIAG: usize = 3;
 
 /// The pair's coefficients (k_p, k_i, s) for fluid particle i and neighbour j
-/// at r² = r2: the projected viscosity's −k_ij (Weiler; `viscosity_form =
-/// "marrone"`) or the isotropic one's (F22 (23)), both ≤ 0, and XSPH's s_ij.
-fn pair(pr: &Params, st: &State, i: usize, j: usize, vol_i: f32, r2: f32) -> [f32; 3] {
-    let r = r2.sqrt();
-    let g = kernel::dw(pr, r) / r;
+/// at x_ij = d with g = ∂W/∂r / r: the projected viscosity's −k_ij (Weiler;
+/// `viscosity_form = "marrone"`) or the isotropic one's (F22 (23)), both ≤ 0,
+/// and XSPH's s_ij.
+fn pair(pr: &Params, st: &State, i: usize, j: usize, vol_i: f32, d: [f32; 3], g: f32) -> [f32; 3] {
+    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     let mu_i = pr.phase(st.phase[i]).implicit_eta;
     let ph_j = st.phase[j];
     let wall = pr.is_wall(ph_j);
@@ -90,46 +91,97 @@ fn pair(pr: &Params, st: &State, i: usize, j: usize, vol_i: f32, r2: f32) -> [f3
     let mut s = 0.0f32;
     if !wall {
         let (rho_i, rho_j) = (st.rho[i], st.rho[j]);
-        s = pr.solve.dfsph_xsph * st.mass[i] * st.mass[j] * kernel::w(pr, r)
+        s = pr.solve.dfsph_xsph * st.mass[i] * st.mass[j] * kernel::w(pr, r2.sqrt())
             / ((rho_i + rho_j) * 0.5);
     }
     [kp, ki, s]
 }
 
-/// Σ_j [−k_p x_ij (x_ij·u_ij) − k_i u_ij + s_ij u_ij] over i's neighbours,
-/// u_ij the difference of `field` (a wall's value: `wall`), and the
-/// diagonal m_i + Σ_j (−k_p x_ij,a² − k_i + s_ij).
-fn sweep(
-    pr: &Params,
-    st: &State,
-    grid: &CellTable,
-    i: usize,
-    field: impl Fn(usize) -> [f32; 3],
-    wall: impl Fn(usize) -> [f32; 3],
-) -> ([f32; 3], [f32; 3]) {
-    let m_i = st.mass[i];
-    let vol_i = m_i / st.rho[i];
-    let f_i = field(i);
-    let mut acc = [0.0f32; 3];
-    let mut dg = [m_i, m_i, m_i];
-    for_each_neighbor(pr, &st.pos, grid, i, |j, d, r2| {
-        if r2 <= 0.0 {
-            return;
+/// The velocity system's pair coefficients (k_p, k_i, s) of this step, in the
+/// order of the pair table's entries (dfsph_pairs; the same offsets): they do
+/// not change between `begin` and the last `apply`, so `begin` evaluates them
+/// once and each CG iteration only multiplies. Valid for one cell table.
+#[derive(Default)]
+pub struct Couplings {
+    generation: u64,
+    chunks: Vec<Vec<[f32; 3]>>,
+}
+
+/// Sums of fluid particle i's row: Σ_j [−k_p x_ij (x_ij·u_ij) − k_i u_ij
+/// + s_ij u_ij], u_ij the difference of `field` (a wall's value: `wall`),
+/// and the diagonal m_i + Σ_j (−k_p x_ij,a² − k_i + s_ij).
+struct Row<F, G> {
+    acc: [f32; 3],
+    dg: [f32; 3],
+    f_i: [f32; 3],
+    field: F,
+    wall: G,
+}
+
+impl<F: Fn(usize) -> [f32; 3], G: Fn(usize) -> [f32; 3]> Row<F, G> {
+    fn new(st: &State, i: usize, field: F, wall: G) -> Self {
+        let m_i = st.mass[i];
+        Row {
+            acc: [0.0; 3],
+            dg: [m_i, m_i, m_i],
+            f_i: field(i),
+            field,
+            wall,
         }
-        let [kp, ki, s] = pair(pr, st, i, j, vol_i, r2);
+    }
+
+    /// Adds pair (j, x_ij = d) with coefficients (k_p, k_i, s).
+    #[inline(always)]
+    fn add(&mut self, pr: &Params, st: &State, j: usize, d: [f32; 3], [kp, ki, s]: [f32; 3]) {
         let f_j = if pr.is_wall(st.phase[j]) {
-            wall(j)
+            (self.wall)(j)
         } else {
-            field(j)
+            (self.field)(j)
         };
+        let f_i = self.f_i;
         let u = [f_i[0] - f_j[0], f_i[1] - f_j[1], f_i[2] - f_j[2]];
         let c = kp * (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]);
+        let (acc, dg) = (&mut self.acc, &mut self.dg);
         for a in 0..3 {
             acc[a] = acc[a] - c * d[a] - ki * u[a] + s * u[a];
             dg[a] = dg[a] - kp * d[a] * d[a] - ki + s;
         }
+    }
+}
+
+/// i's row over pairs (j, x_ij, coefficients) already evaluated.
+fn sum_pairs(
+    pr: &Params,
+    st: &State,
+    i: usize,
+    pairs: impl Iterator<Item = (usize, [f32; 3], [f32; 3])>,
+    field: impl Fn(usize) -> [f32; 3],
+    wall: impl Fn(usize) -> [f32; 3],
+) -> ([f32; 3], [f32; 3]) {
+    let mut row = Row::new(st, i, field, wall);
+    for (j, d, k) in pairs {
+        row.add(pr, st, j, d, k);
+    }
+    (row.acc, row.dg)
+}
+
+/// i's row with each pair's coefficients evaluated here (no couplings
+/// recorded this step), in the same order.
+fn sweep(
+    pr: &Params,
+    st: &State,
+    grid: &CellTable,
+    table: &PairTable,
+    i: usize,
+    field: impl Fn(usize) -> [f32; 3],
+    wall: impl Fn(usize) -> [f32; 3],
+) -> ([f32; 3], [f32; 3]) {
+    let vol_i = st.mass[i] / st.rho[i];
+    let mut row = Row::new(st, i, field, wall);
+    for_each_pair(pr, &st.pos, grid, table, i, |j, d, g| {
+        row.add(pr, st, j, d, pair(pr, st, i, j, vol_i, d, g));
     });
-    (acc, dg)
+    (row.acc, row.dg)
 }
 
 /// J22 (15)–(16) as printed, on the right side (positions of this step):
@@ -239,30 +291,72 @@ pub fn wall_velocities(pr: &Params, st: &mut State, grid: &CellTable) {
     }
 }
 
+/// One fluid particle's row at x0 = v*: (i, Σ pair terms, diag(A), the
+/// cohesion and adhesion impulse).
+type BeginRow = (usize, [f32; 3], [f32; 3], [f32; 3]);
+
 /// `dfsph_viscosity_begin` and its sums: r, diag(A), p = z at x0 = v*; the
-/// solver reset with r·z and r0·r0, converged at once when r·z = 0.
-pub fn begin(pr: &Params, st: &mut State, grid: &CellTable) {
+/// solver reset with r·z and r0·r0, converged at once when r·z = 0. Records
+/// the step's couplings when the pair table holds this step's pairs.
+pub fn begin(
+    pr: &Params,
+    st: &mut State,
+    grid: &CellTable,
+    table: &PairTable,
+    couplings: &mut Couplings,
+) {
     let s: &State = st;
     let cohesive = pr.solve.dfsph_cohesion > 0.0 || pr.solve.dfsph_adhesion > 0.0;
-    let rows: Vec<(usize, [f32; 3], [f32; 3], [f32; 3])> = fluid(pr, s)
-        .into_par_iter()
-        .map(|i| {
-            let (acc, dg) = sweep(
-                pr,
-                s,
-                grid,
-                i,
-                |j| xyz(s.vel[j]),
-                |j| xyz(s.dfsph_cg[4 * j + R]),
-            );
-            let c = if cohesive {
-                cohesion_impulse(pr, s, grid, i)
-            } else {
-                [0.0; 3]
-            };
-            (i, acc, dg, c)
-        })
-        .collect();
+    let row = |i: usize, (acc, dg): ([f32; 3], [f32; 3])| -> BeginRow {
+        let c = if cohesive {
+            cohesion_impulse(pr, s, grid, i)
+        } else {
+            [0.0; 3]
+        };
+        (i, acc, dg, c)
+    };
+    let at_v = |j: usize| xyz(s.vel[j]);
+    let wall_v = |j: usize| xyz(s.dfsph_cg[4 * j + R]);
+    couplings.generation = 0;
+    let rows: Vec<BeginRow> = if let Some(pairs) = table.chunks(grid) {
+        let mut chunks = std::mem::take(&mut couplings.chunks);
+        chunks.resize_with(pairs.len(), Vec::new);
+        let n = s.active();
+        let rows: Vec<Vec<BeginRow>> = pairs
+            .par_iter()
+            .zip(chunks.par_iter_mut())
+            .enumerate()
+            .map(|(c, (chunk, coef))| {
+                coef.clear();
+                let range = c * LIST_CHUNK..((c + 1) * LIST_CHUNK).min(n);
+                range
+                    .filter(|&i| !pr.is_wall(s.phase[i]))
+                    .map(|i| {
+                        let ps = chunk.of(i % LIST_CHUNK);
+                        let vol_i = s.mass[i] / s.rho[i];
+                        let base = coef.len();
+                        coef.extend(
+                            ps.iter()
+                                .map(|p| pair(pr, s, i, p.j as usize, vol_i, p.d, p.g)),
+                        );
+                        let terms = ps
+                            .iter()
+                            .zip(&coef[base..])
+                            .map(|(p, &k)| (p.j as usize, p.d, k));
+                        row(i, sum_pairs(pr, s, i, terms, at_v, wall_v))
+                    })
+                    .collect()
+            })
+            .collect();
+        couplings.chunks = chunks;
+        couplings.generation = grid.generation;
+        rows.into_iter().flatten().collect()
+    } else {
+        fluid(pr, s)
+            .into_par_iter()
+            .map(|i| row(i, sweep(pr, s, grid, table, i, at_v, wall_v)))
+            .collect()
+    };
     for (i, acc, dg, c) in rows {
         // Negated, not 0 − acc: lavapipe folds 0 − x into −x (−0 at x = 0).
         st.dfsph_cg[4 * i + R] = if cohesive {
@@ -285,19 +379,44 @@ pub fn begin(pr: &Params, st: &mut State, grid: &CellTable) {
     };
 }
 
-/// `dfsph_viscosity_apply` (and its sums): q = A p, α = r·z / p·q.
-pub fn apply(pr: &Params, st: &mut State, grid: &CellTable) {
+/// `dfsph_viscosity_apply` (and its sums): q = A p, α = r·z / p·q; from the
+/// step's couplings when `begin` recorded them.
+pub fn apply(
+    pr: &Params,
+    st: &mut State,
+    grid: &CellTable,
+    table: &PairTable,
+    couplings: &Couplings,
+) {
     if converged(st) {
         return;
     }
     let s: &State = st;
-    let rows: Vec<(usize, [f32; 3])> = fluid(pr, s)
-        .into_par_iter()
-        .map(|i| {
-            let (acc, _) = sweep(pr, s, grid, i, |j| xyz(s.dfsph_cg[4 * j + P]), |_| [0.0; 3]);
-            (i, acc)
-        })
-        .collect();
+    let at_p = |j: usize| xyz(s.dfsph_cg[4 * j + P]);
+    let zero = |_: usize| [0.0; 3];
+    let recorded = table
+        .chunks(grid)
+        .filter(|_| couplings.generation == grid.generation);
+    let rows: Vec<(usize, [f32; 3])> = if let Some(pairs) = recorded {
+        fluid(pr, s)
+            .into_par_iter()
+            .map(|i| {
+                let (c, k) = (i / LIST_CHUNK, i % LIST_CHUNK);
+                let chunk = &pairs[c];
+                let at = chunk.offsets[k] as usize..chunk.offsets[k + 1] as usize;
+                let terms = chunk.pairs[at.clone()]
+                    .iter()
+                    .zip(&couplings.chunks[c][at])
+                    .map(|(p, &k)| (p.j as usize, p.d, k));
+                (i, sum_pairs(pr, s, i, terms, at_p, zero).0)
+            })
+            .collect()
+    } else {
+        fluid(pr, s)
+            .into_par_iter()
+            .map(|i| (i, sweep(pr, s, grid, table, i, at_p, zero).0))
+            .collect()
+    };
     for (i, acc) in rows {
         let m = st.mass[i];
         let p = st.dfsph_cg[4 * i + P];

@@ -21,6 +21,8 @@ pub trait Lane:
     fn max0(self) -> Self;
     /// Per lane: `then` where self < bound, else `other` (`other` for a NaN).
     fn where_lt(self, bound: f32, then: Self, other: Self) -> Self;
+    /// The correctly rounded square root (`sqrtss`, or one lane of `vsqrtps`).
+    fn sqrt(self) -> Self;
 }
 
 impl Lane for f32 {
@@ -39,6 +41,10 @@ impl Lane for f32 {
         } else {
             other
         }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
     }
 }
 
@@ -68,6 +74,13 @@ mod avx {
     pub(crate) struct F8(pub(crate) __m256);
 
     impl F8 {
+        /// Eight lanes into a register (gathered scalars).
+        #[inline(always)]
+        pub(crate) fn from_array(x: [f32; 8]) -> F8 {
+            // SAFETY: as the operators below: an F8 is made only where AVX is
+            // enabled; the load reads the eight f32 of `x`.
+            F8(unsafe { _mm256_loadu_ps(x.as_ptr()) })
+        }
         /// The register as eight lanes (for tests and scalar tails).
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 8] {
@@ -123,6 +136,11 @@ mod avx {
                 _mm256_blendv_ps(other.0, then.0, lt)
             })
         }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            // SAFETY: as above.
+            F8(unsafe { _mm256_sqrt_ps(self.0) })
+        }
     }
 }
 
@@ -149,8 +167,9 @@ mod tests {
             1.0,
         ];
         let b = [7.0f32, 1.0e-3, -0.0, 2.0, 1.0, 3.0, 0.1, 1.0];
+        // a also holds a negative (sqrt: NaN), ±0 and a subnormal.
         #[target_feature(enable = "avx2")]
-        fn lanes(a: [f32; 8], b: [f32; 8]) -> [[f32; 8]; 8] {
+        fn lanes(a: [f32; 8], b: [f32; 8]) -> [[f32; 8]; 10] {
             // SAFETY: AVX2 is enabled in this function.
             let (x, y) = unsafe {
                 (
@@ -167,6 +186,8 @@ mod tests {
                 x.max0().to_array(),
                 x.where_lt(1.0, x, y).to_array(),
                 (F8::splat(2.0) * x).to_array(),
+                x.sqrt().to_array(),
+                F8::from_array(b).to_array(),
             ]
         }
         // SAFETY: the CPU has AVX2 (checked above).
@@ -182,6 +203,8 @@ mod tests {
                 x.max0(),
                 x.where_lt(1.0, x, y),
                 2.0 * x,
+                x.sqrt(),
+                y,
             ];
             for (op, w) in want.iter().enumerate() {
                 assert_eq!(got[op][k].to_bits(), w.to_bits(), "op {op}, lane {k}");

@@ -47,12 +47,13 @@
 //!   gives about 2e-5 m/s² at Δx = 0.8 µm, nothing against a 200 m/s impact,
 //!   so J22's value is not the scene's (issue 30's note).
 
-use super::dfsph_pairs::{for_each_pair, PairTable};
+use super::dfsph_pairs::{for_each_pair, Pair, PairTable};
 use super::neighbors::{for_each_neighbor, CellTable, LIST_CHUNK};
 use super::reduce::tree_total;
 use super::terms::pair_viscosity;
 use crate::backend::schedule::SolverSlot;
 use crate::kernel;
+use crate::lanes::Lane;
 use crate::params::{Params, PHASE_FREE_SLIP};
 use crate::state::{Solver, State};
 use rayon::prelude::*;
@@ -64,37 +65,107 @@ const P: usize = 1;
 const Q: usize = 2;
 const DIAG: usize = 3;
 
-/// The pair's coefficients (k_p, k_i, s) for fluid particle i and neighbour j
-/// at x_ij = d with g = ∂W/∂r / r: the projected viscosity's −k_ij (Weiler;
-/// `viscosity_form = "marrone"`) or the isotropic one's (F22 (23)), both ≤ 0,
-/// and XSPH's s_ij.
-fn pair(pr: &Params, st: &State, i: usize, j: usize, vol_i: f32, d: [f32; 3], g: f32) -> [f32; 3] {
+/// What the coefficients of fluid particle i's pairs share.
+struct RowOf {
+    mu_i: f32,
+    vol_i: f32,
+    m_i: f32,
+    rho_i: f32,
+}
+
+impl RowOf {
+    fn new(pr: &Params, st: &State, i: usize) -> Self {
+        RowOf {
+            mu_i: pr.phase(st.phase[i]).implicit_eta,
+            vol_i: st.mass[i] / st.rho[i],
+            m_i: st.mass[i],
+            rho_i: st.rho[i],
+        }
+    }
+}
+
+/// What the coefficients take of neighbour j, in the order of `coefficients`'
+/// lanes: μ_ij, V_j, m_j, ρ_j, g, r², and 1 for a fluid j (0 for a wall).
+#[inline(always)]
+fn gather(pr: &Params, st: &State, row: &RowOf, j: usize, d: [f32; 3], g: f32) -> [f32; 7] {
     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    let mu_i = pr.phase(st.phase[i]).implicit_eta;
     let ph_j = st.phase[j];
     let wall = pr.is_wall(ph_j);
     let (mu, vol_j) = if wall {
         let slip = pr.phase(ph_j).flags & PHASE_FREE_SLIP != 0;
-        (pair_viscosity(mu_i, mu_i, slip), st.dfsph[j][0])
+        (pair_viscosity(row.mu_i, row.mu_i, slip), st.dfsph[j][0])
     } else {
-        let mu = pair_viscosity(mu_i, pr.phase(ph_j).implicit_eta, false);
+        let mu = pair_viscosity(row.mu_i, pr.phase(ph_j).implicit_eta, false);
         (mu, st.mass[j] / st.rho[j])
     };
-    let dt = st.sim.dt;
-    let (mut kp, mut ki) = (0.0f32, 0.0f32);
+    let fluid = if wall { 0.0 } else { 1.0 };
+    [mu, vol_j, st.mass[j], st.rho[j], g, r2, fluid]
+}
+
+/// The pair's coefficients (k_p, k_i, s) from `gather`'s values, on one pair
+/// or on eight (`Lane`, the same operations): the projected viscosity's −k_ij
+/// (Weiler; `viscosity_form = "marrone"`) or the isotropic one's (F22 (23)),
+/// both ≤ 0, and XSPH's s_ij (0 against a wall).
+#[inline(always)]
+fn coefficients<R: Lane>(pr: &Params, dt: f32, row: &RowOf, q: [R; 7]) -> [R; 3] {
+    let [mu, vol_j, m_j, rho_j, g, r2, fluid] = q;
+    let c = R::splat;
+    let (vol_i, zero) = (c(row.vol_i), c(0.0));
+    let (mut kp, mut ki) = (zero, zero);
     if pr.solve.dfsph_viscosity_form == 1 {
-        let f = dt * pr.solve.viscosity_factor;
-        kp = f * mu * vol_i * vol_j * g / (r2 + pr.solve.dfsph_viscosity_eps);
+        let f = c(dt * pr.solve.viscosity_factor);
+        kp = f * mu * vol_i * vol_j * g / (r2 + c(pr.solve.dfsph_viscosity_eps));
     } else {
-        ki = dt * mu * (vol_i * vol_i + vol_j * vol_j) * g;
+        ki = c(dt) * mu * (vol_i * vol_i + vol_j * vol_j) * g;
     }
-    let mut s = 0.0f32;
-    if !wall {
-        let (rho_i, rho_j) = (st.rho[i], st.rho[j]);
-        s = pr.solve.dfsph_xsph * st.mass[i] * st.mass[j] * kernel::w(pr, r2.sqrt())
-            / ((rho_i + rho_j) * 0.5);
+    let s = c(pr.solve.dfsph_xsph) * c(row.m_i) * m_j * kernel::w(pr, r2.sqrt())
+        / ((c(row.rho_i) + rho_j) * c(0.5));
+    [kp, ki, fluid.where_lt(0.5, zero, s)]
+}
+
+/// One pair's coefficients (k_p, k_i, s), x_ij = d, g = ∂W/∂r / r.
+#[inline(always)]
+fn pair(pr: &Params, st: &State, row: &RowOf, j: usize, d: [f32; 3], g: f32) -> [f32; 3] {
+    coefficients(pr, st.sim.dt, row, gather(pr, st, row, j, d, g))
+}
+
+/// The coefficients of i's pairs `ps`, in their order, onto `out`: eight at
+/// a time where the CPU has AVX2 (the same bits: `coefficients` is the same
+/// operations on each lane).
+fn row_coefficients(pr: &Params, st: &State, i: usize, ps: &[Pair], out: &mut Vec<[f32; 3]>) {
+    let row = RowOf::new(pr, st, i);
+    #[cfg(target_arch = "x86_64")]
+    if *crate::lanes::AVX2 {
+        // SAFETY: the CPU has AVX2 (checked once at run time).
+        return unsafe { row_coefficients_avx2(pr, st, &row, ps, out) };
     }
-    [kp, ki, s]
+    out.extend(ps.iter().map(|p| pair(pr, st, &row, p.j as usize, p.d, p.g)));
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn row_coefficients_avx2(
+    pr: &Params,
+    st: &State,
+    row: &RowOf,
+    ps: &[Pair],
+    out: &mut Vec<[f32; 3]>,
+) {
+    use crate::lanes::F8;
+    let dt = st.sim.dt;
+    for block in ps.chunks(8) {
+        // Lanes past the block's end repeat its first pair (dropped below).
+        let mut q = [[0.0f32; 8]; 7];
+        for lane in 0..8 {
+            let p = block[if lane < block.len() { lane } else { 0 }];
+            let g = gather(pr, st, row, p.j as usize, p.d, p.g);
+            for (k, v) in g.into_iter().enumerate() {
+                q[k][lane] = v;
+            }
+        }
+        let [kp, ki, s] = coefficients(pr, dt, row, q.map(F8::from_array)).map(F8::to_array);
+        out.extend((0..block.len()).map(|lane| [kp[lane], ki[lane], s[lane]]));
+    }
 }
 
 /// The velocity system's pair coefficients (k_p, k_i, s) of this step, in the
@@ -176,10 +247,10 @@ fn sweep(
     field: impl Fn(usize) -> [f32; 3],
     wall: impl Fn(usize) -> [f32; 3],
 ) -> ([f32; 3], [f32; 3]) {
-    let vol_i = st.mass[i] / st.rho[i];
+    let of = RowOf::new(pr, st, i);
     let mut row = Row::new(st, i, field, wall);
     for_each_pair(pr, &st.pos, grid, table, i, |j, d, g| {
-        row.add(pr, st, j, d, pair(pr, st, i, j, vol_i, d, g));
+        row.add(pr, st, j, d, pair(pr, st, &of, j, d, g));
     });
     (row.acc, row.dg)
 }
@@ -333,12 +404,8 @@ pub fn begin(
                     .filter(|&i| !pr.is_wall(s.phase[i]))
                     .map(|i| {
                         let ps = chunk.of(i % LIST_CHUNK);
-                        let vol_i = s.mass[i] / s.rho[i];
                         let base = coef.len();
-                        coef.extend(
-                            ps.iter()
-                                .map(|p| pair(pr, s, i, p.j as usize, vol_i, p.d, p.g)),
-                        );
+                        row_coefficients(pr, s, i, ps, coef);
                         let terms = ps
                             .iter()
                             .zip(&coef[base..])

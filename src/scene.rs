@@ -927,9 +927,9 @@ pub struct CheckDef {
     /// splat: the droplet's phase (default: every liquid phase), for scenes
     /// whose substrate is a liquid phase too (J22 §4.2).
     pub phase: Option<String>,
-    /// splat: a reference spread factor D_max/D0 (J22 §4.2). With it the
-    /// verdict is the spread factor's relative departure from it, not J22's
-    /// Fluent-case timings.
+    /// splat: a reference spread factor D/D0 of the splat at the run's end
+    /// (J22 §4.2 measured its splats after 2 µs). With it the verdict is the
+    /// relative departure from it, not J22's Fluent-case timings.
     pub spread_factor: Option<f64>,
     /// deposition: the first grain's reference arrival at the substrate (s).
     pub arrival: Option<f64>,

@@ -639,7 +639,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
                 if !(xi.is_finite() && xi >= 1.0) {
                     return Err(cx.err(
                         "check.spread_factor",
-                        format!("a spread factor D_max/D0 is at least 1, got {xi}"),
+                        format!("a spread factor D/D0 is at least 1, got {xi}"),
                     ));
                 }
             }

@@ -129,7 +129,6 @@ impl PairTable {
     pub fn chunks(&self, grid: &CellTable) -> Option<&[PairChunk]> {
         (self.generation != 0 && self.generation == grid.generation).then_some(&self.chunks[..])
     }
-
 }
 
 /// `f(j, x_ij, g)` for every neighbour j ≠ i of fluid particle i in the

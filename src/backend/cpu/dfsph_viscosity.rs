@@ -139,7 +139,10 @@ fn row_coefficients(pr: &Params, st: &State, i: usize, ps: &[Pair], out: &mut Ve
         // SAFETY: the CPU has AVX2 (checked once at run time).
         return unsafe { row_coefficients_avx2(pr, st, &row, ps, out) };
     }
-    out.extend(ps.iter().map(|p| pair(pr, st, &row, p.j as usize, p.d, p.g)));
+    out.extend(
+        ps.iter()
+            .map(|p| pair(pr, st, &row, p.j as usize, p.d, p.g)),
+    );
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -98,7 +98,13 @@ impl CpuBackend {
         dfsph::boundary_volume(&self.params, &mut self.st)
     }
     pub(crate) fn dfsph_factor(&mut self) {
-        dfsph::factor(&self.params, &mut self.st, &self.grid, &mut self.list, &mut self.pairs)
+        dfsph::factor(
+            &self.params,
+            &mut self.st,
+            &self.grid,
+            &mut self.list,
+            &mut self.pairs,
+        )
     }
     pub(crate) fn dfsph_begin(&mut self, slot: SolverSlot) {
         dfsph::begin(&self.params, &mut self.st, &self.grid, &self.pairs, slot)

@@ -23,7 +23,7 @@
 //! temperature: T(h) and f_l(h) per material, linear over the melting band, and
 //!   the solid ↔ liquid switch at f_l = ½.
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::neighbors::{for_each_listed, for_each_neighbor, CellTable, NeighborList};
 use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
@@ -84,14 +84,21 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
 /// liquid fractions in heat.z): conduction, the laser's source (W/kg), viscous
 /// heating, minus the surface losses.
 #[inline(always)]
-fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) -> f32 {
+fn rate(
+    pr: &Params,
+    st: &State,
+    grid: &CellTable,
+    list: &NeighborList,
+    i: usize,
+    laser_source: f32,
+) -> f32 {
     let (pos, rho, mass, phase, heat) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
     let eta2 = pr.kernel.eta2;
     let ph_i = phase[i];
     let k_i = conductivity(pr, ph_i, heat[i][H_TEMPERATURE], heat[i][H_LIQUID]);
     let t_i = heat[i][H_TEMPERATURE];
     let mut sum = 0.0f32;
-    for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
+    for_each_listed(pr, pos, grid, list, i, |j, _, r2| {
         if r2 <= 0.0 {
             return;
         }
@@ -125,7 +132,7 @@ fn rate(pr: &Params, st: &State, grid: &CellTable, i: usize, laser_source: f32) 
 
 /// `conduct`: explicit Euler, h_i += Δt dh_i/dt (J22 (21)); the laser pass left
 /// its source (W/kg) in heat.w.
-pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     let dt = st.sim.dt;
     let laser_on = pr.laser.model != 0;
     let s: &State = st;
@@ -139,6 +146,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable) {
                 pr,
                 s,
                 grid,
+                list,
                 i,
                 if laser_on { s.heat[i][H_RATE] } else { 0.0 },
             )
@@ -223,7 +231,7 @@ pub fn iterate_temperature(pr: &Params, st: &mut State) {
 /// `iterate_conduct`: ḣ_k (kept as ḣ_0 in heat_start.z on the first
 /// iteration), h^{k+1} = h^n + Δt ((ḣ_0 + ḣ_k)/2), and |ḣ_k − ḣ_{k−1}| into
 /// heat_start.w (rates, not enthalpies: lavapipe folds (a + b) − a to b).
-pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     if heat_converged(st) {
         return;
     }
@@ -236,7 +244,7 @@ pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable) {
             if !pr.conducts(s.phase[i]) {
                 return 0.0;
             }
-            rate(pr, s, grid, i, s.heat_start[i][1])
+            rate(pr, s, grid, list, i, s.heat_start[i][1])
         })
         .collect();
     let phase = &st.phase;

@@ -21,7 +21,7 @@
 //! V = m/ρ (summation density for fluids, ρ0 for solids and walls), κ_F22 the
 //! same planar-lattice normalisation of the condensed side's δ.
 
-use super::neighbors::{for_each_neighbor, CellTable};
+use super::neighbors::{for_each_listed, for_each_neighbor, CellTable, NeighborList};
 use crate::kernel;
 use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
@@ -36,7 +36,7 @@ pub fn condensed(pr: &Params, phase: u32) -> bool {
 /// `shepard` (free-surface form): Γ_i = Σ_j V_j W_ij over condensed neighbours
 /// (V = m/ρ0), into surface[n + i].x (y, z zeroed) for the particles still in the
 /// simulation.
-pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     let (n, active) = (st.len(), st.active());
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
     let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
@@ -47,7 +47,7 @@ pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable) {
                 return 0.0;
             }
             let mut g = 0.0f32;
-            for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
+            for_each_listed(pr, pos, grid, list, i, |j, _, r2| {
                 if condensed(pr, phase[j]) {
                     g += vol(j) * kernel::w(pr, r2.sqrt());
                 }
@@ -62,7 +62,7 @@ pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable) {
 
 /// `normals`: F22's gas-interface form, or the free-surface form R18 (3.25)–(3.27)
 /// from the Shepard sums `shepard` left in surface[n + j].x.
-pub fn normals(pr: &Params, st: &mut State, grid: &CellTable) {
+pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     if pr.flag(FLAG_GAS_INTERFACE) {
         return gas_interface(pr, st, grid);
     }
@@ -78,7 +78,7 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable) {
                 return [0.0; 4];
             }
             let mut g = [0.0f32; 3];
-            for_each_neighbor(pr, pos, grid, i, |j, d, r2| {
+            for_each_listed(pr, pos, grid, list, i, |j, d, r2| {
                 if r2 <= 0.0 || !condensed(pr, phase[j]) {
                     return;
                 }

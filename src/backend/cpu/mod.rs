@@ -164,10 +164,10 @@ impl CpuBackend {
         wall::run(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn shepard(&mut self) {
-        interface::shepard(&self.params, &mut self.st, &self.grid)
+        interface::shepard(&self.params, &mut self.st, &self.grid, &self.list)
     }
     pub(crate) fn normals(&mut self) {
-        interface::normals(&self.params, &mut self.st, &self.grid)
+        interface::normals(&self.params, &mut self.st, &self.grid, &self.list)
     }
     pub(crate) fn wetting(&mut self) {
         interface::wetting(&self.params, &mut self.st, &self.grid)
@@ -209,7 +209,7 @@ impl CpuBackend {
         heat::wall_temperature(&self.params, &mut self.st, &self.grid)
     }
     pub(crate) fn conduct(&mut self) {
-        heat::conduct(&self.params, &mut self.st, &self.grid)
+        heat::conduct(&self.params, &mut self.st, &self.grid, &self.list)
     }
     pub(crate) fn heat_begin(&mut self) {
         heat::begin(&self.params, &mut self.st)
@@ -223,7 +223,7 @@ impl CpuBackend {
         }
     }
     pub(crate) fn iterate_conduct(&mut self) {
-        heat::iterate_conduct(&self.params, &mut self.st, &self.grid)
+        heat::iterate_conduct(&self.params, &mut self.st, &self.grid, &self.list)
     }
     pub(crate) fn heat_residual(&mut self) {
         heat::residual(&self.params, &mut self.st)

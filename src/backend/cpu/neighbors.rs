@@ -250,18 +250,22 @@ impl NeighborList {
         }
     }
 
+    /// Particle i's recorded neighbours; None without a list for this cell
+    /// table, or for a particle the list holds none of (a wall: every fluid
+    /// particle's entry holds at least itself).
     fn of(&self, grid: &CellTable, i: usize) -> Option<&[u32]> {
         if self.generation == 0 || self.generation != grid.generation {
             return None;
         }
         let c = &self.chunks[i / LIST_CHUNK];
         let k = i % LIST_CHUNK;
-        Some(&c.j[c.offsets[k] as usize..c.offsets[k + 1] as usize])
+        let js = &c.j[c.offsets[k] as usize..c.offsets[k + 1] as usize];
+        (!js.is_empty()).then_some(js)
     }
 }
 
-/// `for_each_neighbor` for a fluid particle, read from the step's neighbour list
-/// when it has one for this cell table: the same j in the same order, with d and
+/// `for_each_neighbor`, read from the step's neighbour list when it holds the
+/// particle's neighbours for this cell table (a fluid particle's): the same j in the same order, with d and
 /// r² recomputed by `min_image` and the same sum, so the same bits. Without a list
 /// the particle's neighbours are swept into a per-thread scratch list first, so
 /// that `f` is called from one loop only: the compiler then inlines it and keeps

@@ -81,6 +81,17 @@ struct FactorSums {
 }
 
 impl FactorSums {
+    fn new(rho0_i: f32) -> Self {
+        FactorSums {
+            rho0_i,
+            sum_f: 0.0,
+            sum_b: 0.0,
+            sq: 0.0,
+            g: [0.0; 3],
+            gb: [0.0; 3],
+        }
+    }
+
     /// Adds neighbour j at x_ij = d, r² < support², with W(r) = w and
     /// ∂W/∂r / r = dw (unused at r = 0); records the pair j ≠ i.
     #[inline(always)]
@@ -138,14 +149,7 @@ fn geometry(pr: &Params, pi: [f32; 4], pj: [f32; 4]) -> ([f32; 3], f32) {
 /// neighbours at a time where the CPU has AVX2 (`kernel::w` and `dw` are the
 /// same operations on each lane), and added in the walk's order.
 fn factor_of(pr: &Params, st: &State, i: usize, js: &[u32], pairs: &mut PairChunk) -> (f32, f32) {
-    let mut sums = FactorSums {
-        rho0_i: pr.phase(st.phase[i]).rho0,
-        sum_f: 0.0,
-        sum_b: 0.0,
-        sq: 0.0,
-        g: [0.0; 3],
-        gb: [0.0; 3],
-    };
+    let mut sums = FactorSums::new(pr.phase(st.phase[i]).rho0);
     let pi = st.pos[i];
     #[cfg(target_arch = "x86_64")]
     if *crate::lanes::AVX2 {
@@ -566,14 +570,7 @@ mod tests {
                 let js = with_neighbors(&pr, &st.pos, &grid, i, |js, _| js.to_vec());
                 let run = |wide: bool| {
                     let mut chunk = PairTable::default().take_chunks(1).remove(0);
-                    let mut sums = FactorSums {
-                        rho0_i: pr.phase(st.phase[i]).rho0,
-                        sum_f: 0.0,
-                        sum_b: 0.0,
-                        sq: 0.0,
-                        g: [0.0; 3],
-                        gb: [0.0; 3],
-                    };
+                    let mut sums = FactorSums::new(pr.phase(st.phase[i]).rho0);
                     if wide {
                         // SAFETY: AVX2 checked above.
                         unsafe {

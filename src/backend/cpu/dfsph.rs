@@ -534,7 +534,7 @@ pub fn drift(pr: &Params, st: &mut State) {
     }
 }
 
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::backend::cpu::neighbors;
@@ -543,6 +543,7 @@ mod tests {
     /// neighbours at a time, give the bits of the one-at-a-time loop, on the
     /// 2D spray droplet (fluid and wall neighbours, r = 0, neighbour counts
     /// that are not multiples of eight) and the 3D DFSPH dam break.
+    #[cfg(target_arch = "x86_64")]
     #[test]
     fn eight_wide_factor_sums_match_the_scalar_loop() {
         if !*crate::lanes::AVX2 {

@@ -247,7 +247,7 @@ impl Check for Splat {
             }
         };
         details.push(format!(
-            "  impact {}{}, mean vertical velocity through zero {}{}, stopped (splat speed < {:.0}% of impact) {}{}; D_max {d_max:.4e} m, spread factor {xi:.3}; the splat at the end {d_end:.4e} m, D/D0 {xi_end:.3} (Re {reynolds:.0}: 0.5 Re^0.25 = {pasandideh:.3}{})",
+            "  impact {}{}, mean vertical velocity through zero {}{}, stopped (splat speed < {:.0}% of impact) {}{}; D_max {d_max:.4e} m, spread factor {xi:.3} (the splat at the end: D {d_end:.4e} m, D/D0 {xi_end:.3} ; Re {reynolds:.0}: 0.5 Re^0.25 = {pasandideh:.3}{})",
             show(impact),
             j22(J22_IMPACT, ""),
             show(zero),

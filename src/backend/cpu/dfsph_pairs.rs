@@ -117,10 +117,14 @@ impl PairTable {
         let recorded = !chunks.iter().any(|c| c.off);
         let pairs: usize = chunks.iter().map(|c| c.pairs.len()).sum();
         self.generation = 0;
-        if recorded && pairs <= max_pairs {
-            self.generation = grid.generation;
-        } else if recorded {
+        if recorded && pairs > max_pairs {
+            // Over the bound: its memory is given back, not kept unread.
             self.skip = RETRY_STEPS;
+            self.chunks = Vec::new();
+            return;
+        }
+        if recorded {
+            self.generation = grid.generation;
         }
         self.chunks = chunks;
     }
@@ -200,6 +204,7 @@ mod tests {
         assert!(t.chunks(&grid).is_some());
         t.store_within(&grid, recorded(4), 3);
         assert!(t.chunks(&grid).is_none());
+        assert!(t.chunks.is_empty(), "an oversized table's memory is kept");
         for _ in 0..RETRY_STEPS {
             let chunks = t.take_chunks(1);
             assert!(chunks[0].off);

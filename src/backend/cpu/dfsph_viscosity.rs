@@ -422,6 +422,8 @@ pub fn begin(
         couplings.generation = grid.generation;
         rows.into_iter().flatten().collect()
     } else {
+        // No pair table this step: the couplings' memory is given back too.
+        couplings.chunks = Vec::new();
         fluid(pr, s)
             .into_par_iter()
             .map(|i| row(i, sweep(pr, s, grid, table, i, at_v, wall_v)))

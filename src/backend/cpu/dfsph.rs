@@ -107,7 +107,7 @@ impl FactorSums {
         pairs: &mut PairChunk,
     ) {
         if r2 > 0.0 {
-            pairs.push(Pair {
+            pairs.push_one(Pair {
                 j: j as u32,
                 d,
                 g: dw,
@@ -586,7 +586,7 @@ mod tests {
                         .chain(sums.gb)
                         .map(f32::to_bits)
                         .collect();
-                    for p in &chunk.pairs {
+                    for p in &chunk.items {
                         bits.extend([p.j, p.g.to_bits()]);
                         bits.extend(p.d.map(f32::to_bits));
                     }

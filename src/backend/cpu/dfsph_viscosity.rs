@@ -476,7 +476,7 @@ pub fn apply(
                 let (c, k) = (i / LIST_CHUNK, i % LIST_CHUNK);
                 let chunk = &pairs[c];
                 let at = chunk.offsets[k] as usize..chunk.offsets[k + 1] as usize;
-                let terms = chunk.pairs[at.clone()]
+                let terms = chunk.items[at.clone()]
                     .iter()
                     .zip(&couplings.chunks[c][at])
                     .map(|(p, &k)| (p.j as usize, p.d, k));

@@ -16,6 +16,7 @@ mod integrate;
 mod interface;
 mod laser;
 mod neighbors;
+mod recorded;
 mod reduce;
 mod surface_forces;
 mod terms;

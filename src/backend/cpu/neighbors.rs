@@ -3,6 +3,7 @@
 //! particles that have left (sorted last, in no cell).
 //! Keys are unique, so any correct sort gives the one order the GPU's bitonic sort gives.
 
+use super::recorded::{Entry, RecordChunk, Recorded};
 use crate::fields::{Held, FIELDS};
 use crate::params::Params;
 use crate::state::State;
@@ -151,117 +152,31 @@ pub fn with_neighbors<R>(
 /// Particles per chunk of the neighbour list (one parallel task each).
 pub const LIST_CHUNK: usize = 1024;
 
-/// Most neighbour indices a list holds: half the memory this machine has free
-/// when the list is first taken, before anything is recorded in it (4 bytes an
-/// index), or 2^27 indices (512 MiB) where that is unknown. A step that records
-/// more keeps none (the bound is checked after that step), and the passes sweep
-/// the cells themselves; at 1e7 particles of dam_break_3d the list takes 2.6 GB
-/// and saves 27% of the forces pass.
-fn list_bound() -> usize {
-    match crate::host::available_memory() {
-        Some(free) => (free / 2.0 / 4.0) as usize,
-        None => 1 << 27,
-    }
+/// A neighbour index: the list may take half the memory this machine has
+/// free when it is first taken, before anything is recorded in it (4 bytes an
+/// index), or 2^27 indices (512 MiB) where that is unknown (cpu/recorded.rs);
+/// at 1e7 particles of dam_break_3d the list takes 2.6 GB and saves 27% of the
+/// forces pass.
+impl Entry for u32 {
+    const MEMORY_SHARE: f64 = 0.5;
+    const BYTES: usize = 4;
+    const UNKNOWN_BOUND: usize = 1 << 27;
 }
-
-/// Steps a list that outgrew its bound is not recorded for before the
-/// next try (recording one only to drop it doubles the density pass's cost).
-const LIST_RETRY_STEPS: u32 = 100;
 
 /// The neighbours of every fluid particle, recorded by the density pass in the
 /// walk's order, so that the forces pass of the same step reads them instead of
 /// sweeping the cells again. Valid for one cell table (`CellTable::generation`).
-#[derive(Default)]
-pub struct NeighborList {
-    generation: u64,
-    chunks: Vec<ListChunk>,
-    /// Steps left before a list that outgrew its bound is recorded again.
-    skip: u32,
-    /// `list_bound()`, read when the list is first taken.
-    max_entries: Option<usize>,
-}
+pub type NeighborList = Recorded<u32>;
 
-/// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK: those of the
-/// k-th are j[offsets[k]..offsets[k + 1]] (none for a wall particle).
-#[derive(Default)]
-pub struct ListChunk {
-    offsets: Vec<u32>,
-    j: Vec<u32>,
-    /// Not recorded this step (`push` does nothing).
-    off: bool,
-}
+/// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK (none for a
+/// wall particle).
+pub type ListChunk = RecordChunk<u32>;
 
-impl ListChunk {
-    fn clear(&mut self) {
-        self.offsets.clear();
-        self.offsets.push(0);
-        self.j.clear();
-    }
-    /// Ends the current particle with neighbours `js` (empty for one not gathered).
-    #[inline(always)]
-    pub fn push(&mut self, js: &[u32]) {
-        if self.off {
-            return;
-        }
-        self.j.extend_from_slice(js);
-        self.offsets.push(self.j.len() as u32);
-    }
-}
-
-impl NeighborList {
-    /// `n` empty chunks for the density pass to fill, reusing the buffers of the
-    /// last step's list (no allocation once the sizes have settled); chunks that
-    /// record nothing while a list that outgrew its bound waits for its retry.
-    pub fn take_chunks(&mut self, n: usize) -> Vec<ListChunk> {
-        let mut chunks = std::mem::take(&mut self.chunks);
-        self.generation = 0;
-        self.max_entries.get_or_insert_with(list_bound);
-        let off = self.skip > 0;
-        self.skip = self.skip.saturating_sub(1);
-        chunks.resize_with(n, ListChunk::default);
-        for c in &mut chunks {
-            c.clear();
-            c.off = off;
-        }
-        chunks
-    }
-
-    /// Keeps the chunks of this step's density pass for `grid`, unless they were
-    /// not recorded or hold more indices than its bound (then the next
-    /// LIST_RETRY_STEPS steps record none).
-    pub fn store(&mut self, grid: &CellTable, chunks: Vec<ListChunk>) {
-        let max = *self.max_entries.get_or_insert_with(list_bound);
-        self.store_within(grid, chunks, max);
-    }
-
-    fn store_within(&mut self, grid: &CellTable, chunks: Vec<ListChunk>, max_entries: usize) {
-        if chunks.iter().any(|c| c.off) {
-            self.chunks = chunks;
-            return;
-        }
-        let entries: usize = chunks.iter().map(|c| c.j.len()).sum();
-        if entries <= max_entries {
-            self.generation = grid.generation;
-            self.chunks = chunks;
-        } else {
-            self.generation = 0;
-            self.chunks = Vec::new();
-            self.skip = LIST_RETRY_STEPS;
-        }
-    }
-
-    /// Particle i's recorded neighbours; None without a list for this cell
-    /// table, or for a particle the list holds none of (a wall: every fluid
-    /// particle's entry holds at least itself).
-    fn of(&self, grid: &CellTable, i: usize) -> Option<&[u32]> {
-        if self.generation == 0 || self.generation != grid.generation {
-            return None;
-        }
-        let c = &self.chunks[i / LIST_CHUNK];
-        let k = i % LIST_CHUNK;
-        let js = &c.j[c.offsets[k] as usize..c.offsets[k + 1] as usize];
-        (!js.is_empty()).then_some(js)
-    }
+/// Particle i's recorded neighbours; None without a list for this cell table,
+/// or for a particle the list holds none of (a wall: every fluid particle's
+/// entry holds at least itself).
+fn listed<'a>(list: &'a NeighborList, grid: &CellTable, i: usize) -> Option<&'a [u32]> {
+    list.entries(grid, i).filter(|js| !js.is_empty())
 }
 
 /// `for_each_neighbor`, read from the step's neighbour list when it holds the
@@ -302,7 +217,7 @@ pub fn with_listed<R>(
     i: usize,
     f: impl FnOnce(&[u32]) -> R,
 ) -> R {
-    if let Some(js) = list.of(grid, i) {
+    if let Some(js) = listed(list, grid, i) {
         return f(js);
     }
     let mut js = SCRATCH.with(|s| s.take());
@@ -719,6 +634,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &mut CellTable) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::backend::cpu::recorded::RETRY_STEPS;
 
     type Visit = (usize, [u32; 3], u32);
 
@@ -766,14 +682,14 @@ mod tests {
                 if !pr.is_wall(st.phase[i]) {
                     let listed = visits(|f| for_each_listed(&pr, pos, &grid, &list, i, f));
                     assert_eq!(walk, listed, "{scene}: list of particle {i}");
-                    assert!(list.of(&grid, i).is_some());
+                    assert!(super::listed(&list, &grid, i).is_some());
                 }
                 pairs += walk.len();
             }
             assert!(pairs > 10 * pos.len(), "{scene}: {pairs} pairs");
             grid.invalidate();
             let i = (0..pos.len()).find(|&i| !pr.is_wall(st.phase[i])).unwrap();
-            assert!(list.of(&grid, i).is_none(), "stale list used");
+            assert!(listed(&list, &grid, i).is_none(), "stale list used");
             let walk = visits(|f| for_each_near(&pr, pos, &grid, pos[i], f));
             let listed = visits(|f| for_each_listed(&pr, pos, &grid, &list, i, f));
             assert_eq!(walk, listed, "{scene}: fallback sweep");
@@ -781,7 +697,7 @@ mod tests {
     }
 
     /// A list over its bound is dropped and not recorded again for
-    /// LIST_RETRY_STEPS steps (the passes sweep the cells meanwhile, with the same
+    /// RETRY_STEPS steps (the passes sweep the cells meanwhile, with the same
     /// neighbours), then recorded again.
     #[test]
     fn a_list_over_its_bound_waits_before_it_is_recorded_again() {
@@ -797,18 +713,21 @@ mod tests {
         }
         list.store_within(&grid, filled, 10);
         assert!(
-            list.of(&grid, fluid).is_none(),
+            listed(&list, &grid, fluid).is_none(),
             "a list over its bound was kept"
         );
-        for step in 0..LIST_RETRY_STEPS {
+        for step in 0..RETRY_STEPS {
             super::super::density::run(&pr, &mut st, &grid, &mut list);
             assert!(
-                list.of(&grid, fluid).is_none(),
+                listed(&list, &grid, fluid).is_none(),
                 "recorded again at step {step}"
             );
         }
         super::super::density::run(&pr, &mut st, &grid, &mut list);
-        assert!(list.of(&grid, fluid).is_some(), "never recorded again");
+        assert!(
+            listed(&list, &grid, fluid).is_some(),
+            "never recorded again"
+        );
     }
 
     /// A walk from inside a neighbour callback (the thread's candidate cache is

@@ -297,6 +297,17 @@ fn steps_toward(left: f64, longest: f64, end: f64) -> u64 {
     }
 }
 
+/// The binding limit's name for the progress line. Under DFSPH the acoustic
+/// limit's sound speed is 0 (`Model::max_sound_speed`), so it is the flow's
+/// CFL 0.25 h/|u|: say so rather than "acoustic".
+fn progress_limit_name(m: &Model, code: u32) -> &'static str {
+    let name = dt_limit_name(code);
+    if name == "acoustic" && m.max_sound_speed() == 0.0 {
+        return "flow CFL";
+    }
+    name
+}
+
 /// Steps between host reads of Δt and time: about 2e6 particle-updates, at most
 /// 200 steps. It depends on the particle count only. Where a run ends is the
 /// device's choice (the steps land on `Sim::end_time`), not the chunking's.
@@ -376,12 +387,11 @@ impl Progress {
         t: f64,
         step: u64,
         dt: f32,
-        limit: u32,
+        limit: &str,
         rate: f64,
     ) {
         let msg = format!(
-            "t = {t:.4e} s, step {step}, dt = {dt:.3e} ({}), {rate:.3e} particle-steps/s",
-            dt_limit_name(limit)
+            "t = {t:.4e} s, step {step}, dt = {dt:.3e} ({limit}), {rate:.3e} particle-steps/s"
         );
         if let Some(b) = &self.bar {
             b.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64);
@@ -478,7 +488,7 @@ pub fn run(
             sim.time as f64,
             steps_done,
             sim.dt,
-            sim.dt_limit,
+            progress_limit_name(m, sim.dt_limit),
             rate,
         );
         trip = watchdog::check_sim(m, &sim, start_dt);

@@ -84,14 +84,21 @@ fn dfsph_factor(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     dfsph[i] = vec4<f32>(alpha, 0.0, 0.0, 0.0);
 }
 
-// D rho_i / Dt = sum_f m_f (v_i - v_f).grad W_if + sum_b rho0_i V_b (v_i - v_b).grad W_ib.
-fn density_rate(i: u32) -> f32 {
+// D rho_i / Dt = sum_f m_f (v_i - v_f).grad W_if + sum_b rho0_i V_b (v_i - v_b).grad W_ib,
+// and the number of neighbours it summed.
+struct Rate {
+    rate: f32,
+    neighbours: u32,
+}
+
+fn density_rate(i: u32) -> Rate {
     let rho0_i = P.phases[phase[i]].rho0;
     let v_i = vel[i];
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
     var rate = 0.0;
+    var neighbours = 0u;
     #for_each_neighbor(ci, zr, j) {
         let d = min_image(pi, pos[j]);
         let r2 = len2(d);
@@ -108,9 +115,10 @@ fn density_rate(i: u32) -> f32 {
             }
             let ud = (v_i.x - u.x) * d.x + (v_i.y - u.y) * d.y + (v_i.z - u.z) * d.z;
             rate = rate + w * ud * (kernel_dw(r) / r);
+            neighbours = neighbours + 1u;
         }
     }
-    return rate;
+    return Rate(rate, neighbours);
 }
 
 // v_i -= dt (sum_f m_f (k_i / rho_i + k_f / rho_f) grad W_if
@@ -184,10 +192,21 @@ fn density_converged() -> bool {
 
 // Divergence error of fluid particle i: D rho / Dt (the sum of k is kept
 // non-negative, so only compression is corrected: a free surface's particles
-// may separate).
+// may separate); 0 for a particle with fewer than a quarter of the lattice's
+// neighbours (spray). There alpha = rho / (a sum of a few |m grad W|^2) grows
+// without bound as its neighbours near the support's edge: a lone droplet
+// particle (3D spread at D0/dx = 25) met one at 2.985 dx, took k_i = 6e15
+// and, warm-started next step with the pair closer, left at 1e4 m/s.
+// SPlisHSPlasH skips the divergence solve below 20 neighbours (3D) for the
+// same reason; its density solve corrects compression only, which a sparse
+// particle never has.
 fn divergence_error(i: u32) {
     var e = dfsph[i];
-    e.y = density_rate(i);
+    let rate = density_rate(i);
+    e.y = rate.rate;
+    if (rate.neighbours < P.solve.dfsph_min_neighbours) {
+        e.y = 0.0;
+    }
     dfsph[i] = e;
 }
 
@@ -195,7 +214,7 @@ fn divergence_error(i: u32) {
 fn density_error(i: u32) {
     var e = dfsph[i];
     let rho0_i = P.phases[phase[i]].rho0;
-    e.y = rho[i] + sim.dt * density_rate(i) - rho0_i;
+    e.y = rho[i] + sim.dt * density_rate(i).rate - rho0_i;
     dfsph[i] = e;
 }
 
@@ -210,9 +229,10 @@ fn relax(i: u32, scale: f32) {
     dfsph[i] = e;
 }
 
-// The warm start (Bender & Koschier 2017 §4.4, as SPlisHSPlasH 2.11 has it):
-// half the previous step's summed k, rescaled to this dt, where the particle
-// is compressed now (its error > 0); 0 elsewhere. In dfsph.z (applied by the
+// The warm start (Bender & Koschier 2017 §4.4): half the previous step's
+// summed k, rescaled to this dt, for every fluid particle (SPlisHSPlasH 2.11
+// applies it only where the particle is compressed now; the relaxation's
+// projection takes back what is not needed). In dfsph.z (applied by the
 // velocity dispatch that follows) and dfsph.w (the sum).
 fn warm_start(i: u32, stored: f32, scale: f32) {
     var e = dfsph[i];

@@ -455,6 +455,10 @@ gpu_struct! {
         /// right side; 0: off.
         pub dfsph_cohesion: f32,
         pub dfsph_adhesion: f32,
+        /// DFSPH: a fluid particle with fewer neighbours than this (a quarter
+        /// of the lattice's, `lattice_neighbours`) takes no part in the
+        /// divergence solve: its error is 0 (spray; see shaders/dfsph.wgsl).
+        pub dfsph_min_neighbours: u32,
     }
 }
 
@@ -707,6 +711,7 @@ impl Params {
             dfsph_viscosity_form: (m.viscosity_form == crate::scene::ViscosityForm::Marrone) as u32,
             dfsph_cohesion: m.dfsph.cohesion as f32,
             dfsph_adhesion: m.dfsph.adhesion as f32,
+            dfsph_min_neighbours: lattice_neighbours(m.dim, m.dx, m.support) / 4,
         };
         if m.delta.is_some() {
             p.sizes.flags |= FLAG_CONTINUITY;
@@ -1263,6 +1268,27 @@ pub fn kernel_w_f64(kind: KernelKind, dim: u32, h: f64, r: f64) -> f64 {
             }
         }
     }
+}
+
+/// The neighbours of a particle inside the square (cubic) lattice: the sites
+/// k ≠ 0 with |k| Δx < support (24 in 2D and 92 in 3D for the quintic's
+/// 3 Δx).
+pub fn lattice_neighbours(dim: u32, dx: f64, support: f64) -> u32 {
+    let reach = (support / dx).ceil() as i64;
+    let z = if dim == 3 { reach } else { 0 };
+    let mut count = 0;
+    for a in -reach..=reach {
+        for b in -reach..=reach {
+            for c in -z..=z {
+                let r = dx * ((a * a + b * b + c * c) as f64).sqrt();
+                // Sites on the support's edge (W = 0) are no neighbours.
+                if r > 0.0 && r < support * (1.0 - 1e-9) {
+                    count += 1;
+                }
+            }
+        }
+    }
+    count
 }
 
 /// Σ_k W(|k| Δx) Δx^d over the square (cubic) lattice: the summation density

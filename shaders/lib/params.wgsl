@@ -127,6 +127,7 @@ struct Solve {                // the formulation and its solvers (backend::sched
     dfsph_viscosity_form: u32,        // 0 F22 (23) (Morris), 1 Weiler 2018 / R18 (3.18)
     dfsph_cohesion: f32,              // J22 (15) gamma_f, 1/s^2
     dfsph_adhesion: f32,              // J22 (16) gamma_b, 1/s^2
+    dfsph_min_neighbours: u32,        // DFSPH: fewer: no divergence solve (spray)
 }
 
 struct Phase {

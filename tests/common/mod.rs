@@ -329,3 +329,48 @@ pub fn figure(c: &spatter::checks::CheckResult, name: &str) -> f64 {
         .map(|f| f.1)
         .unwrap_or_else(|| panic!("no figure {name} in {}: {:?}", c.line(), c.figures))
 }
+
+/// Two lone DFSPH particles (2D, no walls, no gravity), the second closing
+/// on the first at 1 m/s (tests/dfsph.rs and tests/bitmatch.rs move it to
+/// the first's support edge).
+pub const DFSPH_LONE_PAIR: &str = r#"
+[simulation]
+dimension = 2
+formulation = "dfsph"
+kernel = "quintic"
+dx = 1.0e-3
+gravity = [0.0, 0.0]
+
+[domain]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+wall_phase = "wall"
+open_sides = ["x_min", "x_max", "y_min", "y_max"]
+
+[materials.liquid]
+density = 1000.0
+viscosity = 1.0e-3
+sound_speed = 1.0
+
+[phases.drop]
+kind = "liquid"
+material = "liquid"
+
+[phases.wall]
+kind = "wall"
+material = "liquid"
+
+[[shapes]]
+phase = "drop"
+box = { min = [0.005, 0.010], max = [0.006, 0.011] }
+
+[[shapes]]
+phase = "drop"
+box = { min = [0.012, 0.010], max = [0.013, 0.011] }
+velocity = [-1.0, 0.0]
+
+[run]
+end_time = 1.0e-2
+max_dt = 1.0e-3
+output_interval = 1.0e-3
+"#;

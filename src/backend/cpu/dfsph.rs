@@ -29,6 +29,10 @@
 //!     stays ≥ 0, so only compression is corrected (a free surface may
 //!     separate, J22 §3.1). Plain Jacobi (ω = 1, increments ≥ 0) overshoots:
 //!     its iteration matrix reaches 2.6 on the 2D quintic lattice.
+//!   - A particle with fewer than `dfsph_min_neighbours` neighbours (a
+//!     quarter of the lattice's: spray) has divergence error 0: its α
+//!     grows without bound as they near the support's edge
+//!     (shaders/dfsph.wgsl `divergence_error`; SPlisHSPlasH's rule too).
 //!   - Residuals: the mean of max(e, 0)/ρ0 over the fluid (times Δt for the
 //!     divergence), at least two iterations for the density, one for the
 //!     divergence. The sum is a fixed two-level tree, the GPU's pairs.
@@ -279,11 +283,18 @@ pub fn factor(
     }
 }
 
-/// Dρ_i/Dt over fluid and boundary neighbours.
-fn density_rate(pr: &Params, st: &State, grid: &CellTable, table: &PairTable, i: usize) -> f32 {
+/// Dρ_i/Dt over fluid and boundary neighbours, and their number.
+fn density_rate(
+    pr: &Params,
+    st: &State,
+    grid: &CellTable,
+    table: &PairTable,
+    i: usize,
+) -> (f32, u32) {
     let rho0_i = pr.phase(st.phase[i]).rho0;
     let v_i = st.vel[i];
     let mut rate = 0.0f32;
+    let mut neighbours = 0u32;
     for_each_pair(pr, &st.pos, grid, table, i, |j, d, dw| {
         let (u, w) = if pr.is_wall(st.phase[j]) {
             let u = pr.phase(st.phase[j]).velocity;
@@ -294,8 +305,9 @@ fn density_rate(pr: &Params, st: &State, grid: &CellTable, table: &PairTable, i:
         };
         let ud = (v_i[0] - u[0]) * d[0] + (v_i[1] - u[1]) * d[1] + (v_i[2] - u[2]) * d[2];
         rate += w * ud * dw;
+        neighbours += 1;
     });
-    rate
+    (rate, neighbours)
 }
 
 /// The new velocity of fluid particle i after the κ of dfsph.z.
@@ -341,15 +353,17 @@ fn converged(st: &State, slot: SolverSlot) -> bool {
 }
 
 /// The solve's error (dfsph.y) of every fluid particle: the divergence's
-/// max(Dρ/Dt, 0), or the density's max(ρ + Δt Dρ/Dt − ρ0, 0).
+/// Dρ/Dt (0 with fewer than `dfsph_min_neighbours`: spray, shaders/dfsph.wgsl
+/// `divergence_error`), or the density's ρ + Δt Dρ/Dt − ρ0.
 fn errors(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     let s: &State = st;
     let dt = s.sim.dt;
     let out: Vec<(usize, f32)> = fluid(pr, s)
         .into_par_iter()
         .map(|i| {
-            let rate = density_rate(pr, s, grid, table, i);
+            let (rate, neighbours) = density_rate(pr, s, grid, table, i);
             let e = match slot {
+                SolverSlot::Divergence if neighbours < pr.solve.dfsph_min_neighbours => 0.0,
                 SolverSlot::Divergence => rate,
                 _ => s.rho[i] + dt * rate - pr.phase(s.phase[i]).rho0,
             };
@@ -363,8 +377,11 @@ fn errors(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot
 
 /// `dfsph_*_begin`: the solver reset, the first errors and the warm start:
 /// κ = ½ K / Δt² (density; K = Δt² Σκ of the last step) or ½ K / Δt
-/// (divergence; K = Δt Σκ) where the particle is compressed now, else 0, in
-/// dfsph.z (the stage's velocity and error dispatches apply it) and dfsph.w.
+/// (divergence; K = Δt Σκ) for every fluid particle (SPlisHSPlasH 2.11
+/// applies it only where the particle is compressed now; here K ≥ 0 is
+/// applied everywhere and the relaxation's projection takes back what is
+/// not needed), in dfsph.z (the stage's velocity and error dispatches apply
+/// it) and dfsph.w.
 pub fn begin(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable, slot: SolverSlot) {
     st.solvers[slot as usize] = st.solvers[slot as usize].reset();
     errors(pr, st, grid, table, slot);

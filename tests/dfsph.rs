@@ -380,7 +380,6 @@ fn runs_end_at_their_end_time() {
     }
 }
 
-
 /// A particle with fewer neighbours than a quarter of the lattice's
 /// (`Solve::dfsph_min_neighbours`) takes no part in the divergence solve: its
 /// factor α = ρ / Σ|m ∇W|² grows as (3 − r/Δx)⁻⁸ as a neighbour nears the
@@ -399,7 +398,10 @@ fn a_lone_pair_meeting_at_the_support_edge_keeps_its_speed() {
     use spatter::params::Params;
     let l = spatter::run::load_str("lone_pair.toml", common::DFSPH_LONE_PAIR, &[]).unwrap();
     let params = Params::new(&l.model, l.state.len() as u32);
-    assert_eq!(params.solve.dfsph_min_neighbours, 6, "24 lattice neighbours / 4");
+    assert_eq!(
+        params.solve.dfsph_min_neighbours, 6,
+        "24 lattice neighbours / 4"
+    );
     for gap in [2.9f32, 2.99, 2.999, 2.9999] {
         let mut st = l.state.clone();
         let moving = (0..st.len()).find(|&i| st.vel[i][0] != 0.0).unwrap();
@@ -415,7 +417,11 @@ fn a_lone_pair_meeting_at_the_support_edge_keeps_its_speed() {
             for i in 0..s.len() {
                 let v = s.vel[i];
                 let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
-                let expected = if s.id[i] == l.state.id[moving] { 1.0 } else { 0.0 };
+                let expected = if s.id[i] == l.state.id[moving] {
+                    1.0
+                } else {
+                    0.0
+                };
                 assert!(
                     // The implicit viscosity (1 mPa s) shares 0.13% of the
                     // momentum by step 7 (1.15 Δx apart).

@@ -1219,6 +1219,17 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
 
 #[cfg(test)]
 mod tests {
+    /// A lattice particle's neighbours inside the support, the sites on its
+    /// edge excluded: the quintic's 3 Δx (24 in 2D: rings of 4, 4, 4, 8, 4;
+    /// 92 in 3D) and a 2 Δx support (8 and 26: |k|² = 4 sits on the edge).
+    #[test]
+    fn lattice_neighbours_count_the_sites_inside_the_support() {
+        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 3.0e-3), 24);
+        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 3.0e-3), 92);
+        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 2.0e-3), 8);
+        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 2.0e-3), 26);
+    }
+
     /// κ for the three kernels at the h/Δx where it was measured by the absorbed
     /// power on a flat plate without normalisation (quintic at Δx 1.0595,
     /// Wendland at 1.2Δx 1.0284, the cubic at Δx 1.1081; at today's defaults
@@ -1270,24 +1281,34 @@ pub fn kernel_w_f64(kind: KernelKind, dim: u32, h: f64, r: f64) -> f64 {
     }
 }
 
-/// The neighbours of a particle inside the square (cubic) lattice: the sites
-/// k ≠ 0 with |k| Δx < support (24 in 2D and 92 in 3D for the quintic's
-/// 3 Δx).
-pub fn lattice_neighbours(dim: u32, dx: f64, support: f64) -> u32 {
+/// Calls `f` with the distance |k| Δx of every site k of the square (cubic)
+/// lattice within `support` of the origin, the origin included.
+fn for_each_lattice_site(dim: u32, dx: f64, support: f64, mut f: impl FnMut(f64)) {
     let reach = (support / dx).ceil() as i64;
     let z = if dim == 3 { reach } else { 0 };
-    let mut count = 0;
     for a in -reach..=reach {
         for b in -reach..=reach {
             for c in -z..=z {
                 let r = dx * ((a * a + b * b + c * c) as f64).sqrt();
-                // Sites on the support's edge (W = 0) are no neighbours.
-                if r > 0.0 && r < support * (1.0 - 1e-9) {
-                    count += 1;
+                if r < support {
+                    f(r);
                 }
             }
         }
     }
+}
+
+/// The neighbours of a particle inside the square (cubic) lattice: the sites
+/// k ≠ 0 with |k| Δx < support (24 in 2D and 92 in 3D for the quintic's
+/// 3 Δx).
+pub fn lattice_neighbours(dim: u32, dx: f64, support: f64) -> u32 {
+    let mut count = 0;
+    // Sites on the support's edge (W = 0) are no neighbours.
+    for_each_lattice_site(dim, dx, support * (1.0 - 1e-9), |r| {
+        if r > 0.0 {
+            count += 1;
+        }
+    });
     count
 }
 
@@ -1295,18 +1316,7 @@ pub fn lattice_neighbours(dim: u32, dx: f64, support: f64) -> u32 {
 /// of a particle inside a lattice of mass ρ0 Δx^d, over ρ0 (1.0026 for the
 /// quintic at h = Δx in 2D).
 pub fn lattice_density_ratio(kind: KernelKind, dim: u32, h: f64, dx: f64, support: f64) -> f64 {
-    let reach = (support / dx).ceil() as i64;
-    let z = if dim == 3 { reach } else { 0 };
     let mut sum = 0.0;
-    for a in -reach..=reach {
-        for b in -reach..=reach {
-            for c in -z..=z {
-                let r = dx * ((a * a + b * b + c * c) as f64).sqrt();
-                if r < support {
-                    sum += kernel_w_f64(kind, dim, h, r);
-                }
-            }
-        }
-    }
+    for_each_lattice_site(dim, dx, support, |r| sum += kernel_w_f64(kind, dim, h, r));
     sum * dx.powi(dim as i32)
 }

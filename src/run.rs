@@ -301,11 +301,10 @@ fn steps_toward(left: f64, longest: f64, end: f64) -> u64 {
 /// limit's sound speed is 0 (`Model::max_sound_speed`), so it is the flow's
 /// CFL 0.25 h/|u|: say so rather than "acoustic".
 fn progress_limit_name(m: &Model, code: u32) -> &'static str {
-    let name = dt_limit_name(code);
-    if name == "acoustic" && m.max_sound_speed() == 0.0 {
+    if code == crate::model::limits::Limit::Acoustic.code() && m.max_sound_speed() == 0.0 {
         return "flow CFL";
     }
-    name
+    dt_limit_name(code)
 }
 
 /// Steps between host reads of Δt and time: about 2e6 particle-updates, at most

@@ -973,11 +973,7 @@ fn dfsph_lone_pair_skips_the_divergence_solve_on_both_twins() {
     let path = common::scratch("bitmatch_lone_pair").join("lone_pair.toml");
     std::fs::write(&path, common::DFSPH_LONE_PAIR).unwrap();
     let st = bit_identical_prepared(path.to_str().unwrap(), &[], 12, |st| {
-        let moving = (0..st.len()).find(|&i| st.vel[i][0] != 0.0).unwrap();
-        let rest = (0..st.len())
-            .find(|&i| i != moving && st.phase[i] == st.phase[moving])
-            .unwrap();
-        st.pos[moving][0] = st.pos[rest][0] + 2.999e-3;
+        common::close_lone_pair(st, 2.999);
     });
     assert!(st.press.iter().all(|&p| p == 0.0), "{:?}", st.press);
 }

@@ -404,11 +404,7 @@ fn a_lone_pair_meeting_at_the_support_edge_keeps_its_speed() {
     );
     for gap in [2.9f32, 2.99, 2.999, 2.9999] {
         let mut st = l.state.clone();
-        let moving = (0..st.len()).find(|&i| st.vel[i][0] != 0.0).unwrap();
-        let rest = (0..st.len())
-            .find(|&i| i != moving && st.phase[i] == st.phase[moving])
-            .unwrap();
-        st.pos[moving][0] = st.pos[rest][0] + gap * 1.0e-3;
+        let moving = common::close_lone_pair(&mut st, gap);
         let mut cpu = CpuBackend::new(params, st);
         cpu.prime();
         for step in 0..10 {

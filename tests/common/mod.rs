@@ -374,3 +374,14 @@ end_time = 1.0e-2
 max_dt = 1.0e-3
 output_interval = 1.0e-3
 "#;
+
+/// Moves DFSPH_LONE_PAIR's moving particle to `gap` (in spacings of 1 mm)
+/// from the one at rest; returns its index.
+pub fn close_lone_pair(st: &mut spatter::state::State, gap: f32) -> usize {
+    let moving = (0..st.len()).find(|&i| st.vel[i][0] != 0.0).unwrap();
+    let rest = (0..st.len())
+        .find(|&i| i != moving && st.phase[i] == st.phase[moving])
+        .unwrap();
+    st.pos[moving][0] = st.pos[rest][0] + gap * 1.0e-3;
+    moving
+}

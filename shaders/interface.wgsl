@@ -17,7 +17,8 @@ fn gets_gas_interface(ph: u32) -> bool {
 
 // Twin of Params::gets_free_surface_normal.
 fn gets_free_surface_normal(ph: u32) -> bool {
-    return conducts(ph) || ((P.sizes.flags & FLAG_SURFACE_TENSION) != 0u && !is_wall(ph));
+    let flows = P.flow.interface_viscosity > 0.0 || (P.sizes.flags & FLAG_SURFACE_TENSION) != 0u;
+    return conducts(ph) || (flows && !is_wall(ph));
 }
 
 fn volume(j: u32) -> f32 {

@@ -880,9 +880,12 @@ impl Params {
                 && !self.is_wall(phase))
     }
     /// Condensed particles the free-surface interface pass gives a normal and δ:
-    /// conducting ones (surface fluxes) and, with surface tension, the fluid ones.
+    /// conducting ones (surface fluxes) and, with surface tension or the interface
+    /// viscosity on, the fluid ones.
     pub fn gets_free_surface_normal(&self, phase: u32) -> bool {
-        self.conducts(phase) || (self.flag(FLAG_SURFACE_TENSION) && !self.is_wall(phase))
+        self.conducts(phase)
+            || ((self.flow.interface_viscosity > 0.0 || self.flag(FLAG_SURFACE_TENSION))
+                && !self.is_wall(phase))
     }
     pub fn heat_flags(&self, phase: u32) -> u32 {
         self.phases[phase as usize].flags

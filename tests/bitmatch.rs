@@ -564,6 +564,21 @@ fn wetting_sessile_drop_200_steps() {
     );
 }
 
+/// Wetting at a free surface (no gas) with F22 (31)-(32)'s interface viscosity
+/// on the free-surface δ: the gas-free sessile drop at 60° with α_0^lg = 1,
+/// 200 steps.
+#[test]
+fn free_surface_wetting_and_interface_viscosity_200_steps() {
+    assert_bit_identical(
+        "sessile_free_drop_2d",
+        &[
+            "surface_tension.contact_angle=60.0",
+            "simulation.interface_viscosity=1.0",
+        ],
+        200,
+    );
+}
+
 /// Issue 16 item 8: the thermocapillary channel (Marangoni flow between a wall
 /// heated as a cosine and a cold one), 200 steps: every Dirichlet wall particle
 /// mirrors its own fixed temperature (heat.x), the Marangoni term along a flat

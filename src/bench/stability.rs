@@ -91,6 +91,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("validation/recoil_layer_2d"), &[]),
     (scene_file!("validation/rosenthal_2d"), &["dx=5e-5"]),
     (scene_file!("validation/sessile_drop_2d"), &[]),
+    (scene_file!("validation/sessile_free_drop_2d"), &[]),
     (scene_file!("validation/settling_disc_2d"), &["dx=0.02"]),
     (scene_file!("validation/square_drop_2d"), &["dx=4e-3"]),
     (scene_file!("validation/stefan_1d"), &["dx=2e-3"]),

@@ -373,11 +373,12 @@ pub(super) fn interface_viscosity_nu(
     if alpha == 0.0 {
         return Ok(0.0);
     }
-    let has = |k: PhaseKind| fluid.iter().any(|p| p.kind == k);
-    if !has(PhaseKind::Liquid) || !has(PhaseKind::Gas) {
+    // F22 (31)-(32) at the liquid-gas interface, or at the liquid's free surface
+    // in a scene without gas (δ of the free-surface form).
+    if !fluid.iter().any(|p| p.kind == PhaseKind::Liquid) {
         return Err(cx.err(
             key,
-            "acts at a liquid–gas interface: the scene needs a liquid and a gas phase",
+            "acts at a liquid's surface (with gas or free): the scene needs a liquid phase",
         ));
     }
     Ok(artificial_nu(alpha, fluid, dim, h))

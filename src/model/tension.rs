@@ -226,7 +226,7 @@ pub(super) fn surface_tension(
     };
     let contact_angle = match &d.contact_angle {
         None => None,
-        Some(def) => Some(contact_angles(cx, def, phases, gas.is_some())?),
+        Some(def) => Some(contact_angles(cx, def, phases, d.model)?),
     };
     let thin_layer_rows = thin_layer_rows(cx, d, gas.is_some(), support, dx)?;
     let colour_laplacian = colour_laplacian(cx, d, gas.is_some())?;
@@ -317,14 +317,16 @@ fn contact_angles(
     cx: &Ctx,
     def: &crate::scene::ContactAngleDef,
     phases: &[PhaseInfo],
-    gas_form: bool,
+    model: crate::scene::TensionModel,
 ) -> Result<Vec<Option<f64>>, InputError> {
     use crate::scene::ContactAngleDef;
     let key = "surface_tension.contact_angle";
-    if !gas_form {
+    // Wetting prescribes the CSF normal near solids (F22 (27)-(29)), with gas or
+    // at a free surface; J22's colour Laplacian has no normal to prescribe.
+    if model == crate::scene::TensionModel::Muller {
         return Err(cx.err(
             key,
-            "wetting (F22 (27)-(29)) prescribes the liquid-gas normal: it needs F22's form with a gas phase",
+            "wetting (F22 (27)-(29)) prescribes the CSF normal: model = \"muller\" (J22 (5)-(8)) has none; use model = \"csf\"",
         ));
     }
     let check = |k: &str, a: f64| -> Result<f64, InputError> {

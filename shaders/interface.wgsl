@@ -9,14 +9,8 @@ fn condensed(ph: u32) -> bool {
     return P.phases[ph].kind != KIND_GAS;
 }
 
-// Twin of Params::gets_gas_interface.
-fn gets_gas_interface(ph: u32) -> bool {
-    let flows = P.flow.interface_viscosity > 0.0 || (P.sizes.flags & FLAG_SURFACE_TENSION) != 0u;
-    return conducts(ph) || (flows && !is_wall(ph));
-}
-
-// Twin of Params::gets_free_surface_normal.
-fn gets_free_surface_normal(ph: u32) -> bool {
+// Twin of Params::gets_interface (both forms).
+fn gets_interface(ph: u32) -> bool {
     let flows = P.flow.interface_viscosity > 0.0 || (P.sizes.flags & FLAG_SURFACE_TENSION) != 0u;
     return conducts(ph) || (flows && !is_wall(ph));
 }
@@ -56,7 +50,7 @@ fn vol_density(j: u32) -> f32 {
 // F22 (19)-(20): condensed-gas interface, for scenes with gas particles.
 fn gas_interface(i: u32) {
     let ph = phase[i];
-    if (!gets_gas_interface(ph)) {
+    if (!gets_interface(ph)) {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }
@@ -179,7 +173,7 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let ph = phase[i];
-    if (!condensed(ph) || !gets_free_surface_normal(ph)) {
+    if (!condensed(ph) || !gets_interface(ph)) {
         surface[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }

@@ -872,17 +872,11 @@ impl Params {
     pub fn conducts(&self, phase: u32) -> bool {
         self.flag(FLAG_HEAT) && self.phases[phase as usize].kind != KIND_WALL
     }
-    /// Particles F22's gas-interface pass gives a normal and δ: conducting ones (for
-    /// the surface fluxes) and, with the interface viscosity on, every fluid one.
-    pub fn gets_gas_interface(&self, phase: u32) -> bool {
-        self.conducts(phase)
-            || ((self.flow.interface_viscosity > 0.0 || self.flag(FLAG_SURFACE_TENSION))
-                && !self.is_wall(phase))
-    }
-    /// Condensed particles the free-surface interface pass gives a normal and δ:
-    /// conducting ones (surface fluxes) and, with surface tension or the interface
-    /// viscosity on, the fluid ones.
-    pub fn gets_free_surface_normal(&self, phase: u32) -> bool {
+    /// Particles the interface pass gives a normal and δ, in either form (F22's
+    /// gas interface, or the free surface for condensed ones): conducting ones (for
+    /// the surface fluxes) and, with surface tension or the interface viscosity on,
+    /// every fluid one.
+    pub fn gets_interface(&self, phase: u32) -> bool {
         self.conducts(phase)
             || ((self.flow.interface_viscosity > 0.0 || self.flag(FLAG_SURFACE_TENSION))
                 && !self.is_wall(phase))

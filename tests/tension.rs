@@ -453,7 +453,10 @@ fn free_surface_sessile_drops_take_their_angles_in_order() {
     let acute = free(&["surface_tension.contact_angle=60.0"]);
     let obtuse = free(&["surface_tension.contact_angle=120.0"]);
     let (a, b, c) = (angle(&acute), angle(&right), angle(&obtuse));
-    assert!(a + 15.0 < b && b + 15.0 < c, "60/90/120 read {a:.1}/{b:.1}/{c:.1}");
+    assert!(
+        a + 15.0 < b && b + 15.0 < c,
+        "60/90/120 read {a:.1}/{b:.1}/{c:.1}"
+    );
 }
 
 /// A 2D disc of molten steel at rest without gas (R = 25 µm = 6.25 Δx, σ = 1.8
@@ -532,7 +535,10 @@ fn a_low_viscosity_free_disc_holds_only_with_the_interface_viscosity() {
             .fold(0.0, f32::max);
         println!("alpha {alpha}: farthest {spread:.2} R, fastest {speed:.3} m/s");
         if holds {
-            assert!(spread < 1.1 && speed < 0.05, "alpha {alpha}: {spread} R, {speed} m/s");
+            assert!(
+                spread < 1.1 && speed < 0.05,
+                "alpha {alpha}: {spread} R, {speed} m/s"
+            );
         } else {
             assert!(spread > 2.0, "alpha {alpha}: the disc held ({spread} R)");
         }

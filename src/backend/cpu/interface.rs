@@ -10,11 +10,11 @@
 //! κ the planar-lattice normalisation (params::surface_delta_integral),
 //! over condensed neighbours j, V = m/ρ0. Stored for conducting liquid and solid
 //! particles, and for liquid ones with surface tension
-//! (`Params::gets_free_surface_normal`).
+//! (`Params::gets_interface`).
 //!
 //! With gas particles in the scene the interface is the condensed–gas one of
 //! F22 (19)–(20) instead, for every conducting particle i (every fluid particle
-//! with the interface viscosity on, `Params::gets_gas_interface`) over neighbours j of the
+//! with the interface viscosity on, `Params::gets_interface`) over neighbours j of the
 //! other class (condensed: liquid, solid, wall; or gas):
 //!   ∇c_i = (1/V_i) Σ_j (V_i² + V_j²) ρ_i/(ρ_i + ρ_j) ∂W/∂r e_ij,
 //!   δ_i = |∇c_i|/κ_F22,  n_i = ∇c_i/|∇c_i| (outward with respect to i's phase),
@@ -74,7 +74,7 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
     let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
         .map(|i| {
-            if !condensed(pr, phase[i]) || !pr.gets_free_surface_normal(phase[i]) {
+            if !condensed(pr, phase[i]) || !pr.gets_interface(phase[i]) {
                 return [0.0; 4];
             }
             let mut g = [0.0f32; 3];
@@ -221,7 +221,7 @@ fn gas_interface(pr: &Params, st: &mut State, grid: &CellTable) {
     let normals: Vec<[f32; 4]> = (0..n)
         .into_par_iter()
         .map(|i| {
-            if !pr.gets_gas_interface(phase[i]) {
+            if !pr.gets_interface(phase[i]) {
                 return [0.0; 4];
             }
             let side = condensed(pr, phase[i]);

@@ -172,14 +172,30 @@ impl Pair<'_> {
             // pressure, and the fluid's own mass.
             let tag = _mm256_castps_si256(tag.0);
             let wall = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_setzero_si256(), tag));
-            let rho_w = c(rho0_i) + p_j / c(c2_i);
-            let vol_w = m_i / rho_w;
-            let rho_j = F8(_mm256_blendv_ps(rho_r.0, rho_w.0, wall));
-            let vol_j = F8(_mm256_blendv_ps(vol_r.0, vol_w.0, wall));
+            // Most batches hold no wall neighbour: their two divisions are
+            // skipped (the blend would keep ρ and V of the record anyway).
+            let (rho_j, vol_j) = if _mm256_movemask_ps(wall) == 0 {
+                (rho_r, vol_r)
+            } else {
+                let rho_w = c(rho0_i) + p_j / c(c2_i);
+                let vol_w = m_i / rho_w;
+                (
+                    F8(_mm256_blendv_ps(rho_r.0, rho_w.0, wall)),
+                    F8(_mm256_blendv_ps(vol_r.0, vol_w.0, wall)),
+                )
+            };
             let vv = vv_i + vol_j * vol_j;
             let fp = terms::pressure(c(p_i), p_j, c(rho_i), rho_j, dwdr, r);
             let phase = _mm256_and_si256(tag, _mm256_set1_epi32(!WALL_BIT as i32));
-            let eta = F8(_mm256_i32gather_ps::<4>(self.eta.as_ptr(), phase));
+            // η̃ of i's phase with each neighbour's: one load when the eight
+            // share a phase (a gather is slow on some CPUs), else a gather.
+            let first = _mm256_permutevar8x32_epi32(phase, _mm256_setzero_si256());
+            let same = _mm256_movemask_epi8(_mm256_cmpeq_epi32(phase, first)) == -1;
+            let eta = if same {
+                c(self.eta[_mm256_cvtsi256_si32(phase) as usize])
+            } else {
+                F8(_mm256_i32gather_ps::<4>(self.eta.as_ptr(), phase))
+            };
             let fv = terms::viscosity(eta, dwdr, r);
             let part = |d: F8, du: F8| F8(_mm256_and_ps((vv * (fp * d + fv * du)).0, keep));
             let main = [

@@ -4,7 +4,7 @@
 //! apart.
 
 mod common;
-use common::{assert_stated_tolerance, figure, run_check, scene, spatter, text};
+use common::{assert_stated_tolerance, figure, print_check, run_check, scene, spatter, text};
 use spatter::checks::CheckResult;
 
 /// The Laplace pressure of the disc in gas: the issue's 3% at R = 20Δx (F22's
@@ -73,6 +73,43 @@ fn r18_young_laplace_case_within_5_percent() {
     assert_stated_tolerance(&scene(name), FREE_SURFACE_LAPLACE_TOLERANCE);
     let c = run_check(name, &[]);
     assert!(c.pass, "{}", c.line());
+}
+
+/// The free-surface CSF holds only an ordered lattice. The same R18 disc with
+/// its particles displaced by up to 0.1Δx (`jitter`, uniform) should hold its
+/// place and its jump as the lattice does: measured (2026-12-06) it does not.
+/// Its centroid accelerates (0.8 mm/s at 1 s, 20 mm/s at 8 s, 0.12 m/s at 24 s:
+/// the CSF sums to a net force, about 20% of σ/(ρR²) on the whole disc), 1 102
+/// of 1 264 particles leave the domain by 35 s and the jump reads +376%.
+/// Causes measured (docs/physics.md, free-surface form, "Disorder"): the
+/// Shepard-corrected gradient gives 54% of the interior particles a normal at
+/// 0.1Δx of disorder (|g|h 0.10 on average against the threshold 0.1 and the
+/// surface row's 1.06), so random, curvature-capped forces act inside the
+/// liquid; and Σ V δ κ n does not vanish on a disordered closed surface. Neither
+/// h = 1.5Δx (no interior normals), a force gate at half the planar surface
+/// row's δ, F22's interface viscosity (1.0 and 7.2) nor a pairwise surface
+/// stress (tensile-unstable at a free surface) held it.
+#[test]
+#[ignore = "the free-surface CSF is unstable on disordered particles: a 0.1 dx jitter sends the R18 disc off (1 102 of 1 264 out, +376%); docs/physics.md"]
+fn r18_young_laplace_disc_holds_with_disordered_particles() {
+    let path = scene("laplace_free_disc_r18_2d");
+    let (l, r) = common::run_loaded(&path, &["jitter=0.1"], None);
+    let st = &r.final_state;
+    let liquid = l.model.phase_index("liquid").unwrap() as u32;
+    let ids: Vec<usize> = (0..st.active()).filter(|&i| st.phase[i] == liquid).collect();
+    let mass: f32 = ids.iter().map(|&i| st.mass[i]).sum();
+    let centroid_speed = (0..2)
+        .map(|a| ids.iter().map(|&i| st.mass[i] * st.vel[i][a]).sum::<f32>() / mass)
+        .map(|v| v * v)
+        .sum::<f32>()
+        .sqrt();
+    let check = r.check.expect("the scene has a check");
+    print_check("laplace_free_disc_r18_2d", &["jitter=0.1"], &check);
+    // None leaves: the lattice run loses none.
+    assert_eq!(st.sim.removed, 0, "particles left the domain");
+    // A drop at rest stays at rest: 1% of the capillary speed σ/μ = 0.29 m/s.
+    assert!(centroid_speed < 2.9e-3, "centroid at {centroid_speed} m/s");
+    assert!(check.pass, "{}", check.line());
 }
 
 /// Issue 28: the free-surface Laplace disc (R = 20Δx, no gas) on R18's δ-SPH,

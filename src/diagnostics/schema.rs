@@ -71,6 +71,9 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
         schema["properties"]["capillary_number"] = num(
             "largest liquid speed as eta |u| / alpha0 (spurious currents of a drop at rest; 0 without surface tension)",
         );
+        schema["properties"]["interior_normals"] = num(
+            "share of surface_area on liquid particles whose Shepard sum reads a full support (>= 0.95): particle disorder inside the liquid taken for surface (0 with gas)",
+        );
     }
     if m.is_thermal() {
         let unit = if m.dim == 2 {

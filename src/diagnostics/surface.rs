@@ -47,7 +47,6 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
         capillary_number: 0.0,
         interior_normals: 0.0,
     };
-    let free_surface = !m.phases.iter().any(|p| p.kind == PhaseKind::Gas);
     let mut interior_area = 0.0f64;
     let mut fastest: f64 = 0.0;
     for i in 0..st.active() {
@@ -77,7 +76,7 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
     } else {
         d.mean_curvature = 0.0;
     }
-    if free_surface && d.surface_area > 0.0 {
+    if m.free_surface_interface() && d.surface_area > 0.0 {
         d.interior_normals = interior_area / d.surface_area;
     }
     if let Some(t) = &m.surface_tension {

@@ -257,6 +257,14 @@ impl Model {
             || self.interface_viscosity > 0.0
             || self.surface_tension.is_some()
     }
+    /// The interface pass takes the free-surface form (R18 (3.25)–(3.27)): the
+    /// scene has no gas phase (with one, `Params::new` picks F22's gas form).
+    pub fn free_surface_interface(&self) -> bool {
+        !self
+            .phases
+            .iter()
+            .any(|p| p.kind == crate::scene::PhaseKind::Gas)
+    }
     pub fn has_surface_losses(&self) -> bool {
         self.phases
             .iter()

@@ -80,11 +80,7 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     {
         list.push(Box::new(DispersionWarning));
     }
-    let free_surface = !m
-        .phases
-        .iter()
-        .any(|p| p.kind == crate::scene::PhaseKind::Gas);
-    if m.surface_tension.is_some() && free_surface && !opts.quiet {
+    if m.surface_tension.is_some() && m.free_surface_interface() && !opts.quiet {
         list.push(Box::new(InteriorNormals { warned: false }));
     }
     list

@@ -142,6 +142,14 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
     );
 }
 
+// The free-surface form's tension acts on particles with a normal; on continuity
+// density only on those whose Shepard sum is short of a full support (twin of
+// bears_tension in src/backend/cpu/surface_forces.rs, which says why).
+fn bears_tension(j: u32, n: u32) -> bool {
+    return surface[j][S_DELTA] != 0.0
+        && ((P.sizes.flags & FLAG_CONTINUITY) == 0u || surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD);
+}
+
 // Free-surface form, first dispatch, R18 (3.28)-(3.29): raw Morris curvature
 // over the liquid's particles with a normal, weights V delta (V = m / rho0),
 // capped at |kappa| <= 1/support; to surface[n + i][S_RAW_CURVATURE] (the Shepard pass zeroed
@@ -154,7 +162,7 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     let n = P.sizes.n_particles;
     let liquid = P.tension.liquid;
     let s_i = surface[i];
-    if (phase[i] != liquid || s_i[S_DELTA] == 0.0) { return; }
+    if (phase[i] != liquid || !bears_tension(i, n)) { return; }
     let pi = pos[i];
     let ci = cell_coord(pi);
     let zr = z_range();
@@ -169,7 +177,7 @@ fn tension_curvature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
             if (phase[j] == liquid && d.x * s_i.x + d.y * s_i.y + d.z * s_i.z >= P.tension.thin_layer_depth) {
                 deep = true;
             }
-            if (phase[j] == liquid && s_j[S_DELTA] != 0.0) {
+            if (phase[j] == liquid && bears_tension(j, n)) {
                 let r = sqrt(r2);
                 let fv = tension_ramp(tension_temperature(j)) * (mass[j] / P.phases[liquid].rho0) * s_j[S_DELTA];
                 den = den + fv * kernel_w(r);
@@ -199,7 +207,7 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let n = P.sizes.n_particles;
     let liquid = P.tension.liquid;
     let s_i = surface[i];
-    if (phase[i] != liquid || s_i[S_DELTA] == 0.0) { return; }
+    if (phase[i] != liquid || !bears_tension(i, n)) { return; }
     let heated = (P.sizes.flags & FLAG_HEAT) != 0u;
     let t_i = tension_temperature(i);
     let pi = pos[i];
@@ -217,7 +225,7 @@ fn tension_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
             let r = sqrt(r2);
             let w = kernel_w(r);
             let v_j = mass[j] / P.phases[ph_j].rho0;
-            if (ph_j == liquid && surface[j][S_DELTA] != 0.0) {
+            if (ph_j == liquid && bears_tension(j, n)) {
                 let fv = tension_ramp(tension_temperature(j)) * v_j * surface[j][S_DELTA];
                 den = den + fv * w;
                 num = num + fv * surface[n + j][S_RAW_CURVATURE] * w;

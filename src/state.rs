@@ -154,6 +154,16 @@ pub const S_CURVATURE: usize = 1;
 pub const S_RAW_CURVATURE: usize = 2;
 /// Free-surface tension with `thin_layer_rows`: 1 on a thin layer's particle.
 pub const S_THIN: usize = 3;
+/// Γ from which a particle's support reads as full. In 2D (quintic, h = Δx) a
+/// lattice's surface row reads 0.78, and 0.69–0.85 under 0.1Δx of disorder
+/// (0.63–0.93 under 0.2Δx); the rows under it and the interior 0.91–1.05 under
+/// 0.1Δx (0.84–1.19 under 0.2Δx) (Python check on lattice patches, 2026-12-06).
+/// The row under a lattice surface has no normal (|g|h = 0.045, under the 0.1
+/// threshold); under 0.1Δx of disorder 54% of the interior has one.
+/// The free-surface form's tension skips particles with a full support (their
+/// normals are disorder's noise: docs/physics.md, free-surface form, "Disorder").
+/// WGSL twin in lib/params.wgsl.
+pub const INTERIOR_SHEPARD: f32 = 0.95;
 /// J22 (5)'s colour c_i (`model = "muller"`), in the raw curvature's slot: the two
 /// free-surface forms never run in one scene.
 pub const S_COLOUR: usize = 2;

@@ -25,13 +25,7 @@ pub struct SurfaceDiagnostics {
     pub interior_normals: f64,
 }
 
-/// Γ from which a particle's support reads as full. In 2D (quintic, h = Δx) a
-/// lattice's surface row reads 0.78, and 0.69–0.85 under 0.1Δx of disorder
-/// (0.63–0.93 under 0.2Δx); the rows under it and the interior 0.91–1.05 under
-/// 0.1Δx (0.84–1.19 under 0.2Δx) (Python check on lattice patches, 2026-12-06).
-/// The row under a lattice surface has no normal (|g|h = 0.045, under the 0.1
-/// threshold); under 0.1Δx of disorder 54% of the interior has one.
-pub const INTERIOR_SHEPARD: f32 = 0.95;
+pub use crate::state::INTERIOR_SHEPARD;
 
 /// The surface figures of `st`; None in scenes without surface tension or recoil.
 pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> {

@@ -80,16 +80,20 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     {
         list.push(Box::new(DispersionWarning));
     }
-    if m.surface_tension.is_some() && m.free_surface_interface() && !opts.quiet {
+    // On continuity density (δ-SPH) the tension skips those particles
+    // (backend::cpu::surface_forces::bears_tension): nothing to warn of.
+    if m.surface_tension.is_some() && m.free_surface_interface() && m.delta.is_none() && !opts.quiet
+    {
         list.push(Box::new(InteriorNormals { warned: false }));
     }
     list
 }
 
 /// Share of the free-surface measure inside the liquid (`interior_normals`) from
-/// which a run is warned, once: the lattice disc reads at most 0.07, the README's
-/// line melt 0.28; R18's disc with 0.1Δx of disorder 0.39 from its start, as it
-/// drifts off (docs/physics.md, free-surface form, "Disorder").
+/// which a run on summation density is warned, once: R18's disc from the lattice
+/// reads at most 0.07, the README's line melt 0.28; the disc with 0.1Δx of
+/// disorder 0.39 from its start, and before the tension skipped those particles
+/// on δ-SPH it drifted off (docs/physics.md, free-surface form, "Disorder").
 pub const INTERIOR_NORMALS_WARNING: f64 = 0.3;
 
 /// The free-surface CSF acting on particle disorder: a warning at the first
@@ -113,7 +117,8 @@ impl Observer for InteriorNormals {
                 "warning: t = {:.6e} s: {:.0}% of the liquid's free-surface measure (sum of V delta) \
                  lies on particles inside the liquid (Shepard sum >= {}): particle disorder has given \
                  them normals, and the free-surface tension acts on that noise as well as on the \
-                 surface: surface-driven figures from here on carry that error (docs/physics.md, \
+                 surface: surface-driven figures from here on carry that error. On \
+                 formulation = \"delta_wcsph\" the tension skips them (docs/physics.md, \
                  free-surface form, \"Disorder\")",
                 st.sim.time as f64,
                 100.0 * d.interior_normals,

@@ -26,9 +26,12 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
+use crate::params::{Params, FLAG_CONTINUITY, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
 use crate::state::State;
-use crate::state::{H_TEMPERATURE, S_COLOUR, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_THIN};
+use crate::state::{
+    H_TEMPERATURE, INTERIOR_SHEPARD, S_COLOUR, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_SHEPARD,
+    S_THIN,
+};
 use rayon::prelude::*;
 
 /// F22 (21) f[T, T_m, T_m + ΔT_s]; 1 without a ramp. max then min, as the WGSL
@@ -62,6 +65,19 @@ fn has_temperature(pr: &Params, ph: u32) -> bool {
 #[inline(always)]
 fn in_pair(pr: &Params, ph: u32) -> bool {
     ph == pr.tension.liquid || ph == pr.tension.gas
+}
+
+/// The free-surface form's tension acts on particles with a normal; on continuity
+/// density (δ-SPH) only on those whose Shepard sum Γ (surface[n + j][S_SHEPARD]) is
+/// short of a full support: particle disorder gives particles inside the liquid
+/// normals in random directions, and a force on them breaks the drop
+/// (docs/physics.md, free-surface form, "Disorder"). Summation density compacts
+/// the surface row to a full support, where the gate would silence the tension
+/// (R = 10Δx disc: −99%), so it keeps R18's rule there.
+#[inline(always)]
+fn bears_tension(pr: &Params, s: &State, n: usize, j: usize) -> bool {
+    s.surface[j][S_DELTA] != 0.0
+        && (!pr.flag(FLAG_CONTINUITY) || s.surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD)
 }
 
 pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
@@ -161,7 +177,7 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
-            if s.phase[i] != liquid || n_i[S_DELTA] == 0.0 {
+            if s.phase[i] != liquid || !bears_tension(pr, s, n, i) {
                 return (0.0, false);
             }
             let (mut num, mut den) = (0.0f32, 0.0f32);
@@ -173,7 +189,7 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
                 {
                     deep = true;
                 }
-                if s.phase[j] != liquid || n_j[3] == 0.0 {
+                if s.phase[j] != liquid || !bears_tension(pr, s, n, j) {
                     return;
                 }
                 let r = r2.sqrt();
@@ -218,7 +234,7 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
         .into_par_iter()
         .map(|i| {
             let n_i = s.surface[i];
-            if s.phase[i] != liquid || n_i[S_DELTA] == 0.0 {
+            if s.phase[i] != liquid || !bears_tension(pr, s, n, i) {
                 return None;
             }
             let t_i = temperature(i);
@@ -228,7 +244,7 @@ pub fn tension_smooth(pr: &Params, st: &mut State, grid: &CellTable) {
                 let ph_j = s.phase[j];
                 let r = r2.sqrt();
                 let w = kernel::w(pr, r);
-                if ph_j == liquid && s.surface[j][S_DELTA] != 0.0 {
+                if ph_j == liquid && bears_tension(pr, s, n, j) {
                     let fv = ramp(pr, temperature(j)) * volume(j) * s.surface[j][S_DELTA];
                     den += fv * w;
                     num += fv * s.surface[n + j][S_RAW_CURVATURE] * w;

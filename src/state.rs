@@ -160,10 +160,12 @@ pub const S_THIN: usize = 3;
 /// 0.1Δx (0.84–1.19 under 0.2Δx) (Python check on lattice patches, 2026-12-06).
 /// The row under a lattice surface has no normal (|g|h = 0.045, under the 0.1
 /// threshold); under 0.1Δx of disorder 54% of the interior has one.
-/// The free-surface form's tension skips particles with a full support (their
-/// normals are disorder's noise: docs/physics.md, free-surface form, "Disorder").
-/// WGSL twin in lib/params.wgsl.
+/// The free-surface form's tension skips particles with a full support and a
+/// colour gradient |g| h below `INTERIOR_GRADIENT` (their normals are disorder's
+/// noise: docs/physics.md, free-surface form, "Disorder"). WGSL twins in
+/// lib/params.wgsl.
 pub const INTERIOR_SHEPARD: f32 = 0.95;
+pub const INTERIOR_GRADIENT: f32 = 0.5;
 /// J22 (5)'s colour c_i (`model = "muller"`), in the raw curvature's slot: the two
 /// free-surface forms never run in one scene.
 pub const S_COLOUR: usize = 2;

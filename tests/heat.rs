@@ -334,8 +334,8 @@ fn particles_without_a_temperature_write_the_ambient_temperature() {
 /// coarse 2D line melt with surface tension, Marangoni and recoil runs to its end
 /// (no watchdog stop), writes an MCAP whose /track `tools/spatter_read.py track`
 /// plots, and prints the melt pool and the track. F22 §4.5 reports only shapes:
-/// the hottest melt passes T_v = 3000 K (measured 3212 K), the remelt depth is
-/// largest where the scan starts (measured 22.4 against 11.7 µm, means of the
+/// the hottest melt passes T_v = 3000 K (measured 3258 K), the remelt depth is
+/// largest where the scan starts (measured 21.8 against 11.7 µm, means of the
 /// first and last tenth of the track; 19.9 against 10.9 on summation density),
 /// and the resolidified surface ends below the initial one (measured −2.3 µm on
 /// average).

@@ -424,14 +424,19 @@ fn flag_and_code_constants_match() {
     for d in &spatter::model::limits::LIMITS {
         assert_eq!(value(d.wgsl), d.limit.code(), "{}", d.wgsl);
     }
-    let c = module
-        .constants
-        .iter()
-        .find(|(_, c)| c.name.as_deref() == Some("INTERIOR_SHEPARD"))
-        .expect("no WGSL constant INTERIOR_SHEPARD")
-        .1;
-    match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::F32(v)) => assert_eq!(v, st::INTERIOR_SHEPARD),
-        ref other => panic!("INTERIOR_SHEPARD: {other:?}"),
+    for (name, v) in [
+        ("INTERIOR_SHEPARD", st::INTERIOR_SHEPARD),
+        ("INTERIOR_GRADIENT", st::INTERIOR_GRADIENT),
+    ] {
+        let c = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no WGSL constant {name}"))
+            .1;
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::F32(w)) => assert_eq!(w, v, "{name}"),
+            ref other => panic!("{name}: {other:?}"),
+        }
     }
 }

@@ -6,11 +6,11 @@
 //! R18's into the run's summary.
 //!
 //! What holds on the coarse track, and is asserted: the substrate penetration
-//! rises with power (R18 0 / 6 / 30 / 42 µm; measured 0 / 4.3 / 12.3 / 15.8
+//! rises with power (R18 0 / 6 / 30 / 42 µm; measured 0 / 4.2 / 12.4 / 14.6
 //! µm), with none at 50 W, as R18. What is printed only: the peak temperature
-//! and speed at 0.26 ms (neighbourhood means; measured 2117 / 3981 / 4718 /
-//! 5309 K against R18's 2700 / 3833 / 4600 / 6100 K, and 2.4 / 3.3 / 2.0 /
-//! 2.2 m/s against 1.2 / 2.8 / 3.5 / 6.0 m/s). They hang on single events: a
+//! and speed at 0.26 ms (neighbourhood means; measured 2117 / 2776 / 4732 /
+//! 5112 K against R18's 2700 / 3833 / 4600 / 6100 K, and 2.4 / 1.7 / 1.9 /
+//! 3.0 m/s against 1.2 / 2.8 / 3.5 / 6.0 m/s). They hang on single events: a
 //! power of 1.8519e6 instead of 1.85185e6 W/m put a droplet lifted off the
 //! 100 W pool at 6487 K.
 

@@ -65,7 +65,7 @@ fn laplace_pressure_at_10_dx_as_measured() {
 }
 
 /// R18 §4.2's own case (R = 1 m, σ = 10 N/m, Δx = 0.05 m) against the 2D
-/// jump σ/R = 10 Pa, not R18's printed σ/(2R): 9.79 Pa, −2.1% (R18 measured 6,
+/// jump σ/R = 10 Pa, not R18's printed σ/(2R): 9.60 Pa, −4.0% (R18 measured 6,
 /// −40%). Unprinted ρ, η, c chosen so that it is the disc below scaled up (12 s).
 #[test]
 fn r18_young_laplace_case_within_5_percent() {
@@ -165,8 +165,8 @@ fn a_free_surface_on_disordered_particles_is_warned_about() {
 }
 
 /// Issue 28: the free-surface Laplace disc (R = 20Δx, no gas) on R18's δ-SPH,
-/// the scene's formulation, without a pressure floor: −3.0% measured (5% asked;
-/// +23.7% at 10Δx, +7.2% at 40Δx). On summation density the
+/// the scene's formulation, without a pressure floor: −4.6% measured (5% asked;
+/// +13.2% at 10Δx, +3.8% at 40Δx). On summation density the
 /// same disc gave +211 / +285 / +764% at R = 10, 20, 40Δx: the surface row's
 /// density is short (737 kg/m³ at t = 0), the pressure floor leaves it at p = 0
 /// and it compacts from 56 particles at 1.00Δx to 92 at 0.49Δx, buckling at the
@@ -184,7 +184,7 @@ fn free_surface_laplace_within_5_percent_at_20_dx() {
     );
 }
 
-/// The same disc at R = 10Δx (2 s) on both formulations: δ-SPH +23.7% measured
+/// The same disc at R = 10Δx (2 s) on both formulations: δ-SPH +13.2% measured
 /// (bound 0.3: first order in Δx/R from here), summation density +211% (bound
 /// 2.5: it only keeps the old form's gap from growing unseen). Both drops stay
 /// together and nearly still (capillary number below 0.1).

@@ -354,8 +354,9 @@ const S_RAW_CURVATURE: u32 = 2u;
 const S_THIN: u32 = 3u;
 const S_COLOUR: u32 = 2u;
 // The free-surface form's tension skips particles whose Shepard sum reads a full
-// support (src/state.rs INTERIOR_SHEPARD).
+// support and whose colour gradient |g| h is below INTERIOR_GRADIENT (src/state.rs).
 const INTERIOR_SHEPARD: f32 = 0.95;
+const INTERIOR_GRADIENT: f32 = 0.5;
 // solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
 // (position xyz, gradient pending): the last liquidus crossing on cooling.
 const SOL_TIME: u32 = 0u;

@@ -358,7 +358,7 @@ fn coarse_line_melt_main_job() {
     assert!(start > end, "first tenth {start}, last tenth {end}");
     let height = track.mean(|s| s.height);
     assert!(height < 0.0, "surface height mean {height}");
-    // The depression under the beam reaches /diagnostics (9.8e-6 m at most,
+    // The depression under the beam reaches /diagnostics (9.9e-6 m at most,
     // measured; half a row is asked) and the track its own channel.
     let r = common::reader(&["summary", mcap.to_str().unwrap()]);
     let sum: serde_json::Value = serde_json::from_slice(&r.stdout).expect("summary");

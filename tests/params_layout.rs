@@ -350,7 +350,7 @@ fn a_member_renamed_or_moved_on_one_side_is_reported() {
 #[test]
 fn flag_and_code_constants_match() {
     let module = naga::front::wgsl::parse_str(PARAMS_WGSL).unwrap();
-    let value = |name: &str| -> u32 {
+    let literal = |name: &str| -> naga::Literal {
         let c = module
             .constants
             .iter()
@@ -358,8 +358,14 @@ fn flag_and_code_constants_match() {
             .unwrap_or_else(|| panic!("no WGSL constant {name}"))
             .1;
         match module.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            naga::Expression::Literal(l) => l,
             ref other => panic!("{name}: {other:?}"),
+        }
+    };
+    let value = |name: &str| -> u32 {
+        match literal(name) {
+            naga::Literal::U32(v) => v,
+            other => panic!("{name}: {other:?}"),
         }
     };
     let expected = [
@@ -428,15 +434,9 @@ fn flag_and_code_constants_match() {
         ("INTERIOR_SHEPARD", st::INTERIOR_SHEPARD),
         ("INTERIOR_GRADIENT", st::INTERIOR_GRADIENT),
     ] {
-        let c = module
-            .constants
-            .iter()
-            .find(|(_, c)| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("no WGSL constant {name}"))
-            .1;
-        match module.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::F32(w)) => assert_eq!(w, v, "{name}"),
-            ref other => panic!("{name}: {other:?}"),
+        match literal(name) {
+            naga::Literal::F32(w) => assert_eq!(w, v, "{name}"),
+            other => panic!("{name}: {other:?}"),
         }
     }
 }

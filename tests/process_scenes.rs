@@ -93,18 +93,14 @@ fn drop_contact_scenes_validate() {
     );
 }
 
-/// F22 §4.5's PBF point melting, the coarse 2D slice (17 s on 2 cores): the four
-/// observables the issue names are met (peak temperature above T_v, a depression
-/// deeper than a quarter of its width while the beam is on, a grain ejected, the
-/// surface under the beam frozen below the plate's top), and the verdict, its
-/// figures and the per-sample series reach the MCAP's `/check` message. The
-/// ejection is the marginal one: one grain of 23 rises 1.32 diameters above the
-/// bed (the bound is 1); before the free-surface tension skipped particles
-/// inside the liquid none rose above 0.36 diameters, without the interface
-/// viscosity one did, with F22's 7.2 unscaled two (the scene's header). F22
-/// drives it partly with the gas flow a gas-free slice has not.
+/// F22 §4.5's PBF point melting, the coarse 2D slice (17 s on 2 cores): peak
+/// temperature above T_v, a depression deeper than a quarter of its width while
+/// the beam is on, the surface under the beam frozen below the plate's top
+/// (the ejection, the fourth observable, is held by its own test below), and
+/// the verdict, its figures and the per-sample series reach the MCAP's `/check`
+/// message. The full-size scene validates and states its cost.
 #[test]
-fn point_melt_coarse_meets_f22s_four_observables_and_writes_them() {
+fn point_melt_coarse_meets_f22s_observables_and_writes_them() {
     let scene = common::scene_at("pbf/point_melt_coarse_2d");
     // 0.5: passes with no criterion missed (the value counts the missed ones).
     common::assert_stated_tolerance(&scene, 0.5);
@@ -119,12 +115,13 @@ fn point_melt_coarse_meets_f22s_four_observables_and_writes_them() {
     assert!(common::figure(&c, "peak_temperature") > 3000.0);
     assert!(common::figure(&c, "depression_aspect") > 0.25);
     assert!(common::figure(&c, "indentation") > 2.5e-6);
-    assert!(common::figure(&c, "ejected_grains") >= 1.0, "{}", c.line());
-    assert!(c.pass && c.value == 0.0, "{}", c.line());
+    // The check counts the missed criteria: at most the ejection.
+    let ejected = common::figure(&c, "ejected_grains") >= 1.0;
+    assert_eq!(c.value, if ejected { 0.0 } else { 1.0 }, "{}", c.line());
     let series = c.series.as_ref().expect("point_melt keeps its series");
     assert_eq!(series.columns[0], "time");
     assert!(
-        series.rows.len() >= 26,
+        series.rows.len() >= 36,
         "a row per frame: {}",
         series.rows.len()
     );
@@ -165,6 +162,21 @@ fn point_melt_coarse_meets_f22s_four_observables_and_writes_them() {
     let path = dir.join("always_on.toml");
     std::fs::write(&path, always_on).unwrap();
     common::assert_input_error(&["validate", &path.to_string_lossy()], "laser.power_until");
+}
+
+/// F22 §4.5's ejected grain on the coarse slice: one grain of 23 rises 1.32
+/// diameters above the bed (the bound is 1), so the check passes 4 of 4. The
+/// margin is thin and the ejection has moved with the surface's treatment:
+/// before the free-surface tension skipped particles inside the liquid none
+/// rose above 0.36 diameters, without F22's interface viscosity one did, with
+/// F22's 7.2 unscaled two (the scene's header). F22 drives it partly with the
+/// gas flow a gas-free slice has not.
+#[test]
+fn point_melt_coarse_ejects_a_grain() {
+    let r = common::run_path(&common::scene_at("pbf/point_melt_coarse_2d"), &[], None);
+    let c = r.check.expect("the scene has a check");
+    assert!(common::figure(&c, "ejected_grains") >= 1.0, "{}", c.line());
+    assert!(c.pass, "{}", c.line());
 }
 
 /// F22 §4.4's directed energy deposition (issue 31; 2 to 3 minutes each on 2

@@ -196,7 +196,7 @@ pub const SWEEPS: &[Sweep] = &[
         name: "laplace_free_sphere_3d",
         text: scene_text!("laplace_free_sphere_3d"),
         sets: &[],
-        // The sphere's radius: R = 5, 8, 10 Δx (10 Δx: 4 224 particles, 128 s).
+        // The sphere's radius: R = 5, 8, 10 Δx (10 Δx: 4 224 particles, 28–49 s).
         length: 0.02,
         cells: &[5, 8, 10],
         expected_order: Some(1.0),

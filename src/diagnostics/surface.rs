@@ -8,7 +8,8 @@ use serde::Serialize;
 /// Surface-force diagnostics (issue 16): the liquid's surface as the interface
 /// pass sees it (Σ V δ over liquid particles with a normal: m² in 3D, m per metre
 /// of depth in 2D), its δ-weighted mean curvature (1/m; scenes with surface
-/// tension, 0 otherwise), the power the recoil pressure does on the liquid,
+/// tension, 0 otherwise; on δ-SPH without gas over the particles the tension
+/// acts on), the power the recoil pressure does on the liquid,
 /// Σ V p_v δ (−n·u) (W; W/m in 2D; 0 without recoil), and the largest liquid
 /// speed as a capillary number η|u|/α0 (the spurious currents of a scene at
 /// rest; 0 without surface tension). In the free-surface form (no gas phase),
@@ -42,6 +43,8 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
         interior_normals: 0.0,
     };
     let mut interior_area = 0.0f64;
+    let mut curvature_area = 0.0f64;
+    let skips_interior = m.free_surface_interface() && m.delta.is_some();
     let mut fastest: f64 = 0.0;
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];
@@ -54,19 +57,27 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
             continue;
         }
         let area = st.mass[i] as f64 / ph.rho0 * s[3] as f64;
-        if st.surface[n + i][crate::state::S_SHEPARD] >= INTERIOR_SHEPARD {
+        let curvature = st.surface[n + i][crate::state::S_CURVATURE];
+        let interior = st.surface[n + i][crate::state::S_SHEPARD] >= INTERIOR_SHEPARD;
+        if interior {
             interior_area += area;
         }
         d.surface_area += area;
-        d.mean_curvature += area * st.surface[n + i][1] as f64;
+        // On δ-SPH the tension skips most interior particles
+        // (backend::cpu::surface_forces::bears_tension), and their curvature
+        // slot stays at the 0 the Shepard pass wrote: not part of the mean.
+        if !(skips_interior && interior && curvature == 0.0) {
+            curvature_area += area;
+            d.mean_curvature += area * curvature as f64;
+        }
         if let Some(e) = ph.recoil() {
             let v = st.vel[i];
             let un = (0..3).map(|a| s[a] as f64 * v[a] as f64).sum::<f64>();
             d.recoil_power -= area * e.pressure(st.heat[i][1] as f64) * un;
         }
     }
-    if m.surface_tension.is_some() && d.surface_area > 0.0 {
-        d.mean_curvature /= d.surface_area;
+    if m.surface_tension.is_some() && curvature_area > 0.0 {
+        d.mean_curvature /= curvature_area;
     } else {
         d.mean_curvature = 0.0;
     }

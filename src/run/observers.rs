@@ -90,10 +90,11 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
 }
 
 /// Share of the free-surface measure inside the liquid (`interior_normals`) from
-/// which a run on summation density is warned, once: R18's disc from the lattice
-/// reads at most 0.07, the README's line melt 0.28; the disc with 0.1Δx of
-/// disorder 0.39 from its start, and before the tension skipped those particles
-/// on δ-SPH it drifted off (docs/physics.md, free-surface form, "Disorder").
+/// which a run on summation density is warned, once. R18's disc there: not
+/// warned from the lattice over 0.2 s, 0.32 with 0.1Δx of disorder and 0.51 with
+/// 0.2Δx (on δ-SPH, where the tension skips those particles: 0.07 from the
+/// lattice, 0.39 with 0.1Δx, which before that rule drifted off; docs/physics.md,
+/// free-surface form, "Disorder"). The powder-bed slice reads 0.35 at 20 µs.
 pub const INTERIOR_NORMALS_WARNING: f64 = 0.3;
 
 /// The free-surface CSF acting on particle disorder: a warning at the first

@@ -159,7 +159,8 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
 
 /// R18 (3.28)–(3.29), the free-surface form's raw curvature (first of its two
 /// dispatches): Morris' κ_i = −Σ_j f_j V_j δ_j (n_i − n_j)·e_ij W'_ij /
-/// Σ_j f_j V_j δ_j W_ij over the liquid's particles j with a normal (j = i in the
+/// Σ_j f_j V_j δ_j W_ij over the liquid's particles j with a normal that
+/// `bears_tension` keeps, for such particles i (j = i in the
 /// denominator), V = m/ρ0 (the interface pass's volume: summation density is short
 /// at a free surface), f = F22 (21)'s ramp as in the gas form; capped at
 /// |κ| ≤ 1/support (R18's κ_max = 1/(2h) for Wendland, whose support is 2h; both

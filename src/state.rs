@@ -165,6 +165,9 @@ pub const S_THIN: usize = 3;
 /// noise: docs/physics.md, free-surface form, "Disorder"). WGSL twins in
 /// lib/params.wgsl.
 pub const INTERIOR_SHEPARD: f32 = 0.95;
+/// |g| h below which a full-support particle's gradient is disorder's noise: up
+/// to 0.24 at 0.1Δx of disorder and about 0.5 at 0.2Δx; a planar lattice's
+/// surface row reads 1.06 (quintic, h = Δx).
 pub const INTERIOR_GRADIENT: f32 = 0.5;
 /// J22 (5)'s colour c_i (`model = "muller"`), in the raw curvature's slot: the two
 /// free-surface forms never run in one scene.

@@ -44,7 +44,7 @@ pub fn surface_diagnostics(m: &Model, st: &State) -> Option<SurfaceDiagnostics> 
     };
     let mut interior_area = 0.0f64;
     let mut curvature_area = 0.0f64;
-    let skips_interior = m.free_surface_interface() && m.delta.is_some();
+    let skips_interior = m.csf_skips_interior();
     let mut fastest: f64 = 0.0;
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];

@@ -265,6 +265,20 @@ impl Model {
             .iter()
             .any(|p| p.kind == crate::scene::PhaseKind::Gas)
     }
+    /// R18's free-surface CSF: surface tension without gas, not J22's colour
+    /// Laplacian.
+    pub fn free_surface_csf(&self) -> bool {
+        self.surface_tension
+            .as_ref()
+            .is_some_and(|t| !t.colour_laplacian)
+            && self.free_surface_interface()
+    }
+    /// That CSF skips the particles inside the liquid (full support, weak
+    /// gradient: backend::cpu::surface_forces::bears_tension) on continuity
+    /// density (δ-SPH); on summation density it keeps R18's threshold alone.
+    pub fn csf_skips_interior(&self) -> bool {
+        self.free_surface_csf() && self.delta.is_some()
+    }
     pub fn has_surface_losses(&self) -> bool {
         self.phases
             .iter()

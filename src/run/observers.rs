@@ -80,10 +80,8 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     {
         list.push(Box::new(DispersionWarning));
     }
-    // On continuity density (δ-SPH) the tension skips those particles
-    // (backend::cpu::surface_forces::bears_tension): nothing to warn of.
-    if m.surface_tension.is_some() && m.free_surface_interface() && m.delta.is_none() && !opts.quiet
-    {
+    // Where the CSF skips those particles (δ-SPH) there is nothing to warn of.
+    if m.free_surface_csf() && !m.csf_skips_interior() && !opts.quiet {
         list.push(Box::new(InteriorNormals { warned: false }));
     }
     list

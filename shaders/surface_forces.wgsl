@@ -142,15 +142,13 @@ fn tension_force(s_i: vec4<f32>, t_i: f32, kappa: f32, gt: vec3<f32>, rho_i: f32
     );
 }
 
-// The free-surface form's tension acts on particles with a normal; on continuity
-// density not on those with a full support and a weak colour gradient (twin of
-// bears_tension in src/backend/cpu/surface_forces.rs, which says why).
+// The free-surface form's tension acts on particles with a normal, but not on
+// those with a full support and a weak colour gradient (twin of bears_tension
+// in src/backend/cpu/surface_forces.rs, which says why).
 fn bears_tension(j: u32, n: u32) -> bool {
     let delta = surface[j][S_DELTA];
     return delta != 0.0
-        && ((P.sizes.flags & FLAG_CONTINUITY) == 0u
-            || surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD
-            || delta >= INTERIOR_GRADIENT * P.surfaces.inv_kappa * P.kernel.inv_h);
+        && (surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD || delta >= P.surfaces.interior_delta);
 }
 
 // Free-surface form, first dispatch, R18 (3.28)-(3.29): raw Morris curvature

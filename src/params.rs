@@ -189,6 +189,11 @@ gpu_struct! {
         pub inv_kappa: f32,
         /// T_ambient⁴ for radiation.
         pub ambient_t4: f32,
+        /// The free-surface CSF skips a particle with a full support whose δ is
+        /// below this: `state::INTERIOR_GRADIENT` inv_kappa inv_h (|g| h <
+        /// INTERIOR_GRADIENT) where `Model::csf_skips_interior`, 0 (skips none)
+        /// elsewhere.
+        pub interior_delta: f32,
     }
 }
 
@@ -743,6 +748,10 @@ impl Params {
                 _ => surface_delta_integral(&p, m.dx),
             };
             p.surfaces.inv_kappa = (1.0 / kappa) as f32;
+            if m.csf_skips_interior() {
+                p.surfaces.interior_delta =
+                    crate::state::INTERIOR_GRADIENT * p.surfaces.inv_kappa * p.kernel.inv_h;
+            }
             p.surfaces.ambient_t4 = m.ambient_temperature.powi(4) as f32;
             p.flow.interface_viscosity = m.interface_viscosity as f32;
         }

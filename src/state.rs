@@ -162,12 +162,13 @@ pub const S_THIN: usize = 3;
 /// threshold); under 0.1Δx of disorder 54% of the interior has one.
 /// The free-surface form's tension skips particles with a full support and a
 /// colour gradient |g| h below `INTERIOR_GRADIENT` (their normals are disorder's
-/// noise: docs/physics.md, free-surface form, "Disorder"). WGSL twins in
+/// noise: docs/physics.md, free-surface form, "Disorder"). WGSL twin in
 /// lib/params.wgsl.
 pub const INTERIOR_SHEPARD: f32 = 0.95;
 /// |g| h below which a full-support particle's gradient is disorder's noise: up
 /// to 0.24 at 0.1Δx of disorder and about 0.5 at 0.2Δx; a planar lattice's
-/// surface row reads 1.06 (quintic, h = Δx).
+/// surface row reads 1.06 (quintic, h = Δx). The passes read it as a δ,
+/// `Surfaces::interior_delta`.
 pub const INTERIOR_GRADIENT: f32 = 0.5;
 /// J22 (5)'s colour c_i (`model = "muller"`), in the raw curvature's slot: the two
 /// free-surface forms never run in one scene.

@@ -71,6 +71,7 @@ struct Tension {             // F22 (24)-(26), (8), (21)
 struct Surfaces {
     inv_kappa: f32,          // 1 / kappa, the surface delta's normalisation
     ambient_t4: f32,         // T_ambient^4 for radiation
+    interior_delta: f32,     // the free-surface CSF skips full-support particles below this delta (0: none)
 }
 
 struct PathPoint {
@@ -354,9 +355,8 @@ const S_RAW_CURVATURE: u32 = 2u;
 const S_THIN: u32 = 3u;
 const S_COLOUR: u32 = 2u;
 // The free-surface form's tension skips particles whose Shepard sum reads a full
-// support and whose colour gradient |g| h is below INTERIOR_GRADIENT (src/state.rs).
+// support and whose delta is below P.surfaces.interior_delta (src/state.rs).
 const INTERIOR_SHEPARD: f32 = 0.95;
-const INTERIOR_GRADIENT: f32 = 0.5;
 // solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
 // (position xyz, gradient pending): the last liquidus crossing on cooling.
 const SOL_TIME: u32 = 0u;

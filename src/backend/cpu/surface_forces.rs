@@ -26,11 +26,11 @@
 
 use super::neighbors::{for_each_neighbor, CellTable};
 use crate::kernel;
-use crate::params::{Params, FLAG_CONTINUITY, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
+use crate::params::{Params, FLAG_HEAT, HEAT_DIRICHLET, PHASE_RECOIL};
 use crate::state::State;
 use crate::state::{
-    H_TEMPERATURE, INTERIOR_GRADIENT, INTERIOR_SHEPARD, S_COLOUR, S_CURVATURE, S_DELTA,
-    S_RAW_CURVATURE, S_SHEPARD, S_THIN,
+    H_TEMPERATURE, INTERIOR_SHEPARD, S_COLOUR, S_CURVATURE, S_DELTA, S_RAW_CURVATURE, S_SHEPARD,
+    S_THIN,
 };
 use rayon::prelude::*;
 
@@ -67,26 +67,24 @@ fn in_pair(pr: &Params, ph: u32) -> bool {
     ph == pr.tension.liquid || ph == pr.tension.gas
 }
 
-/// The free-surface form's tension acts on particles with a normal; on continuity
-/// density (δ-SPH) not on those that are inside the liquid by both measures: a
-/// Shepard sum Γ (surface[n + j][S_SHEPARD]) of a full support and a weak colour
-/// gradient, |g| h < `INTERIOR_GRADIENT` (δ = |g|/κ: δ < INTERIOR_GRADIENT
-/// inv_kappa inv_h). Particle disorder gives particles inside
-/// the liquid normals in random directions (|g| h up to 0.24 at 0.1Δx of
-/// disorder, 0.5 at 0.2Δx; a planar surface row reads 1.06), and a force on them
-/// breaks the drop (docs/physics.md, free-surface form, "Disorder"). A concave
-/// surface (melt between grains, a keyhole) can read a full support with a
-/// strong gradient: it keeps its tension (R18's track at Δx = 4 µm lost 417
-/// particles without that exception, 11 with it). Summation density compacts
-/// the surface row to a full support, where the rule would silence the tension
-/// (R = 10Δx disc: −99%), so it keeps R18's threshold alone.
+/// The free-surface form's tension acts on particles with a normal, but not on
+/// those inside the liquid by both measures: a Shepard sum Γ (surface[n + j]
+/// [S_SHEPARD]) of a full support and a weak colour gradient, δ below
+/// `Surfaces::interior_delta` (|g| h < `INTERIOR_GRADIENT`; 0, skipping none,
+/// except on continuity density: `Model::csf_skips_interior`). Particle disorder
+/// gives particles inside the liquid normals in random directions (|g| h up to
+/// 0.24 at 0.1Δx of disorder, 0.5 at 0.2Δx; a planar surface row reads 1.06),
+/// and a force on them breaks the drop (docs/physics.md, free-surface form,
+/// "Disorder"). A concave surface (melt between grains, a keyhole) can read a
+/// full support with a strong gradient: it keeps its tension (R18's track at
+/// Δx = 4 µm lost 417 particles without that exception, 11 with it). Summation
+/// density compacts the surface row to a full support, where the rule would
+/// silence the tension (R = 10Δx disc: −99%), so it keeps R18's threshold alone.
 #[inline(always)]
 fn bears_tension(pr: &Params, s: &State, n: usize, j: usize) -> bool {
     let delta = s.surface[j][S_DELTA];
     delta != 0.0
-        && (!pr.flag(FLAG_CONTINUITY)
-            || s.surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD
-            || delta >= INTERIOR_GRADIENT * pr.surfaces.inv_kappa * pr.kernel.inv_h)
+        && (s.surface[n + j][S_SHEPARD] < INTERIOR_SHEPARD || delta >= pr.surfaces.interior_delta)
 }
 
 pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {

@@ -138,8 +138,10 @@ fn load_at(s: &BenchScene, dx: f64) -> Result<Loaded, SpatterError> {
 }
 
 /// Δx that gives about `target` particles: scaled by the count ratio's root of
-/// the scene's dimension.
-fn scene_of_size(s: &BenchScene, target: f64) -> Result<Loaded, SpatterError> {
+/// the scene's dimension. Err(why) when the scene refuses the spacing that
+/// size needs (the powder bed's smallest grains cover no lattice site below
+/// about 3e4 particles): that size is skipped, the others are measured.
+fn scene_of_size(s: &BenchScene, target: f64) -> Result<Result<Loaded, String>, SpatterError> {
     let (sc, resolved) = scene::parse_str(s.label, s.text, &[])?;
     let mut dx = model::build(s.label, &sc, &resolved)?.dx;
     let mut l = load_at(s, dx)?;
@@ -149,9 +151,17 @@ fn scene_of_size(s: &BenchScene, target: f64) -> Result<Loaded, SpatterError> {
             break;
         }
         dx *= ratio.powf(1.0 / l.model.dim as f64);
-        l = load_at(s, dx)?;
+        l = match load_at(s, dx) {
+            Ok(l) => l,
+            Err(SpatterError::Input(e)) => {
+                return Ok(Err(format!(
+                    "the scene is refused at dx = {dx:.3e} m, the spacing that size needs ({e})"
+                )))
+            }
+            Err(e) => return Err(e),
+        };
     }
-    Ok(l)
+    Ok(Ok(l))
 }
 
 fn lost(e: crate::backend::DeviceLost) -> SpatterError {
@@ -314,7 +324,7 @@ fn chosen(names: &[String]) -> Result<Vec<&'static BenchScene>, SpatterError> {
                 InputError::new(
                     "bench throughput",
                     "--scenes",
-                    format!("unknown scene `{n}` (known: dam_break_3d, line_melt)"),
+                    format!("unknown scene `{n}` (known: dam_break_3d, line_melt, powder_bed)"),
                 )
                 .into()
             })
@@ -359,7 +369,15 @@ pub fn throughput(opts: &Options) -> Result<(), SpatterError> {
         );
         let mut last_rate: [Option<f64>; 2] = [None, None];
         for &target in opts.sizes {
-            let l = scene_of_size(s, target)?;
+            let l = match scene_of_size(s, target)? {
+                Ok(l) => l,
+                Err(why) => {
+                    let line = format!("{}: about {target:.0} particles skipped: {why}", s.name);
+                    println!("{line}");
+                    report.skipped.push(line);
+                    continue;
+                }
+            };
             let mut cpu =
                 CpuBackend::new(Params::new(&l.model, l.state.len() as u32), l.state.clone());
             cpu.prime();

@@ -59,6 +59,11 @@ fn body_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let q = b.q;
     let n = sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
     b.q = vec4<f32>(q.x / n, q.y / n, q.z / n, q.w / n);
+    // Its centre left the domain through an open side: it moves no more, and
+    // body_place marks its members as leaving.
+    if (outside_keep_box(b.x)) {
+        b.bonded = BODY_LEFT;
+    }
     bodies[k] = b;
 }
 
@@ -69,8 +74,14 @@ fn body_place(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let k = body[id[i]];
     if (k == NO_BODY) { return; }
     let b = bodies[k];
-    let r = quat_rotate(b.q, body_offset[id[i]].xyz);
     var x = pos[i];
+    if (b.bonded == BODY_LEFT) {
+        // The time it left in w: the next sort removes it (neighbors.wgsl).
+        x.w = sim.time + sim.dt;
+        pos[i] = x;
+        return;
+    }
+    let r = quat_rotate(b.q, body_offset[id[i]].xyz);
     for (var c = 0u; c < 3u; c++) {
         x[c] = b.x[c] + r[c];
     }
@@ -282,7 +293,7 @@ fn bond_body(k: u32) {
     }
     b.count = kept;
     b.x.w = m_new;
-    b.bonded = 1u;
+    b.bonded = BODY_BONDED;
     b.v = vec4<f32>(0.0);
     b.l = vec4<f32>(0.0);
     b.force = vec4<f32>(0.0);

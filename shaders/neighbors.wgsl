@@ -50,9 +50,14 @@ fn cell_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         // A fluid particle outside the keep box has left: its key, n_cells, sorts
         // it after every cell and keeps it out of the cell table (issue 18). Walls
         // stay, wherever they stand (those of a closed side reach past the open
-        // face above it).
+        // face above it), except the members of a rigid body that left, which
+        // body_place stamped with the time it left (w > 0).
+        var gone = outside_keep_box(pos[i]);
+        if (is_wall(phase[i])) {
+            gone = pos[i].w > 0.0;
+        }
         var c = P.sizes.n_cells;
-        if (is_wall(phase[i]) || !outside_keep_box(pos[i])) {
+        if (!gone) {
             c = cell_index(cell_coord(pos[i]));
         }
         keys[i] = vec2<u32>(c, i);

@@ -248,7 +248,8 @@ pub fn grain_rise(m: &Model, st: &State) -> Option<Vec<f64>> {
         let crate::model::BodySource::Grain(g) = spec.source else {
             continue;
         };
-        if st.bodies[k].moves() {
+        // A grain that left through an open side counts where it left.
+        if st.bodies[k].moves() || st.bodies[k].left() {
             let height = m.to_world(st.bodies[k].x)[up];
             rise[g] = (height - top) / (2.0 * bed.grains[g].radius);
         }
@@ -257,11 +258,13 @@ pub fn grain_rise(m: &Model, st: &State) -> Option<Vec<f64>> {
 }
 
 /// What became of the rigid bodies (issue 17 item 6): bonded into the
-/// substrate, fully molten, partly molten, whole.
+/// substrate, left the domain through an open side, fully molten, partly
+/// molten, whole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BodyTally {
     pub bodies: usize,
     pub bonded: usize,
+    pub left: usize,
     pub molten: usize,
     pub partly_molten: usize,
     pub whole: usize,
@@ -274,8 +277,10 @@ impl BodyTally {
             ..Default::default()
         };
         for b in &st.bodies {
-            if b.bonded != 0 {
+            if b.bonded == crate::state::BODY_BONDED {
                 t.bonded += 1;
+            } else if b.left() {
+                t.left += 1;
             } else if b.count == 0 {
                 t.molten += 1;
             } else if b.count < b.initial_count {
@@ -287,8 +292,12 @@ impl BodyTally {
         t
     }
     pub fn summary(&self) -> String {
+        let left = match self.left {
+            0 => String::new(),
+            n => format!(", {n} left the domain through an open side"),
+        };
         format!(
-            "{} rigid: {} whole, {} partly molten, {} fully molten, {} bonded into the substrate",
+            "{} rigid: {} whole, {} partly molten, {} fully molten, {} bonded into the substrate{left}",
             self.bodies, self.whole, self.partly_molten, self.molten, self.bonded
         )
     }

@@ -165,6 +165,11 @@ pub const S_THIN: usize = 3;
 /// noise: docs/physics.md, free-surface form, "Disorder"). WGSL twin in
 /// lib/params.wgsl.
 pub const INTERIOR_SHEPARD: f32 = 0.95;
+
+/// `Body::bonded`: bonded into the substrate (WGSL twin in shaders/lib/params.wgsl).
+pub const BODY_BONDED: u32 = 1;
+/// `Body::bonded`: the body's centre left the keep box through an open side.
+pub const BODY_LEFT: u32 = 2;
 /// |g| h below which a full-support particle's gradient is disorder's noise: up
 /// to 0.24 at 0.1Δx of disorder and about 0.5 at 0.2Δx; a planar lattice's
 /// surface row reads 1.06 (quintic, h = Δx). The passes read it as a δ,
@@ -217,9 +222,11 @@ pub struct Body {
     /// body's particles now.
     pub first: u32,
     pub count: u32,
-    /// 1 once the body is bonded into the substrate by melt that solidified next
-    /// to it: its members are fixed solid particles from then on (still listed,
-    /// `count` of them) and no body pass moves it.
+    /// 0 while free; BODY_BONDED once bonded into the substrate by melt that
+    /// solidified next to it: its members are fixed solid particles from then
+    /// on (still listed, `count` of them) and no body pass moves it; BODY_LEFT
+    /// once its centre has left the domain through an open side: its members
+    /// are removed as leaving fluid is (still listed), and no pass moves it.
     pub bonded: u32,
     /// Members at the start: the range `first..first + initial_count` is the
     /// body's own in `State::members`.
@@ -230,6 +237,10 @@ impl Body {
     /// Still a free body: members left and not bonded (the body passes skip the rest).
     pub fn moves(&self) -> bool {
         self.count > 0 && self.bonded == 0
+    }
+    /// Its centre left the domain through an open side (`BODY_LEFT`).
+    pub fn left(&self) -> bool {
+        self.bonded == BODY_LEFT
     }
     /// The fraction of its particles that melted away.
     pub fn molten_fraction(&self) -> f64 {

@@ -353,3 +353,35 @@ fn settling_disc_reaches_faxen_terminal_velocity() {
     // fill of its area (measured k = 0.2523: the area radius of the filled disc).
     assert!((figure(&c, "k") - 0.25).abs() < 0.01, "{}", c.line());
 }
+
+/// A grain that leaves through an open side is removed (before 2026-12-06 it
+/// flew on outside the domain, in the edge cells, until the watchdog called it
+/// a wall crossing): collision_2d's left grain thrown out through x_min at
+/// 0.1 m/s. Once its centre crosses the open face its members are removed as
+/// leaving fluid is, its motion stops there, and the tally says so; the other
+/// grain flies on.
+#[test]
+fn a_grain_leaving_through_an_open_side_is_removed() {
+    let (l, r) = common::run_loaded(
+        &scene("collision_2d"),
+        &["shapes[0].velocity=[-0.1, 0.0]"],
+        Some(EndCondition::Steps(600)),
+    );
+    let st = &r.final_state;
+    let (gone, stays) = (&st.bodies[0], &st.bodies[1]);
+    assert!(gone.left() && !gone.moves(), "{:?}", gone.x);
+    assert!(stays.moves() && !stays.left());
+    assert_eq!(
+        st.sim.removed, gone.count,
+        "its members are the removed ones"
+    );
+    // Its centre started 4.5 mm inside and crossed x_min at 0.045 s; it stops
+    // within the step (0.1 m/s × 1e-4 s = 1e-5 m) that took it across.
+    let x = l.model.to_world(gone.x)[0];
+    assert!((-1.0e-5..0.0).contains(&x), "stopped at x = {x}");
+    let tally = BodyTally::of(st);
+    assert_eq!((tally.left, tally.whole), (1, 1), "{}", tally.summary());
+    assert!(tally
+        .summary()
+        .ends_with("1 left the domain through an open side"));
+}

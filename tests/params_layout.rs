@@ -423,6 +423,8 @@ fn flag_and_code_constants_match() {
         ("SOL_COOLING", st::SOL_COOLING),
         ("SOL_COUNT", st::SOL_COUNT),
         ("SOL_PENDING", st::SOL_PENDING),
+        ("BODY_BONDED", st::BODY_BONDED as usize),
+        ("BODY_LEFT", st::BODY_LEFT as usize),
     ];
     for (name, v) in slots {
         assert_eq!(value(name), v as u32, "{name}");

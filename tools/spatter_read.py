@@ -6,7 +6,7 @@ Set up its environment once (from the repository root):
 
 Commands:
     spatter_read.py summary RUN.mcap             JSON: frames, particles per frame, diagnostics, time span, removals,
-                                                 rigid bodies (count, bonded, molten away at the end)
+                                                 rigid bodies (count, bonded, molten away, left the domain at the end)
     spatter_read.py plot RUN.mcap OUT.png        /diagnostics against simulated time
     spatter_read.py export-last RUN.mcap DIR     last frame's fields as raw little-endian arrays
     spatter_read.py compare-vtk RUN.mcap VTKDIR  last MCAP frame against the last .vtu of the series
@@ -199,6 +199,8 @@ def summary(path):
         if info["bodies"] else 0,
         "bodies_molten": sum(1 for b in info["bodies"][-1]["bodies"]
                              if b.get("particles") == 0 and not b.get("bonded"))
+        if info["bodies"] else 0,
+        "bodies_left": sum(1 for b in info["bodies"][-1]["bodies"] if b.get("left"))
         if info["bodies"] else 0,
         "complete": info["complete"],
         "has_scenario": "scenario" in info["metadata"].get("spatter", {}),

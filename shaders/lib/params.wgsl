@@ -295,7 +295,7 @@ struct Body {
     torque: vec4<f32>,       // sum of (x_r - x_k) x f_r
     first: u32,              // members[first .. first + count] (melted ones dropped)
     count: u32,
-    bonded: u32,             // 1: bonded into the substrate (count 0)
+    bonded: u32,             // 0 free, BODY_BONDED, or BODY_LEFT (left the domain)
     initial_count: u32,      // members at the start
 }
 
@@ -357,6 +357,9 @@ const S_COLOUR: u32 = 2u;
 // The free-surface form's tension skips particles whose Shepard sum reads a full
 // support and whose delta is below P.surfaces.interior_delta (src/state.rs).
 const INTERIOR_SHEPARD: f32 = 0.95;
+// Body.bonded: bonded into the substrate; the centre left through an open side.
+const BODY_BONDED: u32 = 1u;
+const BODY_LEFT: u32 = 2u;
 // solidification[id] is (time, G, cooling rate, crossings), solidification[n + id]
 // (position xyz, gradient pending): the last liquidus crossing on cooling.
 const SOL_TIME: u32 = 0u;

@@ -239,7 +239,8 @@ pub fn bodies_message(m: &Model, st: &State) -> serde_json::Value {
                 "mass": mo.mass,
                 "particles": b.count,
                 "molten_fraction": b.molten_fraction(),
-                "bonded": b.bonded != 0,
+                "bonded": b.bonded == crate::state::BODY_BONDED,
+                "left": b.left(),
             })
         })
         .collect();

@@ -163,9 +163,10 @@ pub fn bodies_schema() -> serde_json::Value {
                     "mass": {"type": "number", "description": "kg (kg per metre of depth in 2D)"},
                     "particles": {"type": "integer", "description": "member particles (melted ones have left)"},
                     "molten_fraction": {"type": "number", "description": "fraction of the body's initial particles that melted away"},
-                    "bonded": {"type": "boolean", "description": "bonded into the substrate by melt that solidified against it (then fixed)"}
+                    "bonded": {"type": "boolean", "description": "bonded into the substrate by melt that solidified against it (then fixed)"},
+                    "left": {"type": "boolean", "description": "its centre left the domain through an open side: its particles were removed as leaving fluid is, and its motion stops where it left"}
                 },
-                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles", "molten_fraction", "bonded"]
+                "required": ["body", "position", "orientation", "velocity", "angular_velocity", "mass", "particles", "molten_fraction", "bonded", "left"]
             }}
         },
         "required": ["time", "bodies"]

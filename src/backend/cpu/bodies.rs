@@ -32,7 +32,7 @@ use super::terms;
 use crate::kernel;
 use crate::params::{Params, PHASE_FREE_SLIP, SHADER_CONSTS};
 use crate::state::H_TEMPERATURE;
-use crate::state::{Body, State, BODY_SOLIDIFIED, NO_BODY};
+use crate::state::{Body, State, BODY_BONDED, BODY_LEFT, BODY_SOLIDIFIED, NO_BODY};
 use rayon::prelude::*;
 
 pub type V3 = [f32; 3];
@@ -136,7 +136,9 @@ fn rotate_free(b: &mut Body, dt: f32) {
     b.q = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
 }
 
-/// `body_drift`: first half kick, drift of the centre, free rotation.
+/// `body_drift`: first half kick, drift of the centre, free rotation. A body
+/// whose centre is then outside the keep box has left through an open side
+/// (BODY_LEFT): it moves no more, and `place` marks its members as leaving.
 pub fn drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
     let g = pr.flow.gravity.to_array();
@@ -149,12 +151,18 @@ pub fn drift(pr: &Params, st: &mut State) {
             b.x[c] += dt * b.v[c];
         }
         rotate_free(b, dt);
+        if pr.outside_keep_box(&b.x) {
+            b.bonded = BODY_LEFT;
+        }
     });
 }
 
-/// `body_place`: every body particle at X + R r0.
+/// `body_place`: every body particle at X + R r0; the members of a body that
+/// left stay where they are and carry the time it left in w, which the next
+/// sort reads as removed (`neighbors::cell_key`).
 pub fn place(st: &mut State) {
     let n = st.active();
+    let left_at = st.sim.time + st.sim.dt;
     let (body, offset, bodies, id) = (&st.body, &st.body_offset, &st.bodies, &st.id);
     st.pos[..n].par_iter_mut().enumerate().for_each(|(i, x)| {
         let k = body[id[i] as usize];
@@ -162,6 +170,10 @@ pub fn place(st: &mut State) {
             return;
         }
         let b = &bodies[k as usize];
+        if b.left() {
+            x[3] = left_at;
+            return;
+        }
         let o = offset[id[i] as usize];
         let r = rotate(b.q, [o[0], o[1], o[2]]);
         for c in 0..3 {
@@ -445,7 +457,7 @@ fn bond_body(pr: &Params, st: &mut State, k: usize, slot: &[u32]) {
     let b = &mut st.bodies[k];
     b.count = kept;
     b.x[3] = m_new;
-    b.bonded = 1;
+    b.bonded = BODY_BONDED;
     b.v = [0.0; 4];
     b.l = [0.0; 4];
     b.force = [0.0; 4];

@@ -577,8 +577,16 @@ fn wrap(c: i32, n: u32, periodic: bool) -> Option<u32> {
 /// fluid particle that has left the domain (issue 18). Walls stay, wherever they
 /// stand (those of a closed side reach past the open face above it).
 #[inline(always)]
+/// A fluid particle outside the keep box has left; so has a wall-kind particle
+/// stamped with the time it left (a member of a rigid body that left,
+/// `bodies::place`). Either sorts after every cell, in none.
 fn cell_key(pr: &Params, p: &[f32; 4], phase: u32) -> u32 {
-    if !pr.is_wall(phase) && pr.outside_keep_box(p) {
+    let gone = if pr.is_wall(phase) {
+        p[3] > 0.0
+    } else {
+        pr.outside_keep_box(p)
+    };
+    if gone {
         pr.sizes.n_cells
     } else {
         cell_index(pr, cell_coord(pr, p))

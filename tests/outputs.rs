@@ -385,7 +385,7 @@ fn unstable_run_stops_with_exit_3_and_a_readable_mcap() {
 /// silence. square_drop_2d at density ratio 100, its viscosities cut to 5e-3 /
 /// 5e-5 Pa s and no interface viscosity: by t = 0.284 s 14 of its 256 particles
 /// are alone in the gas. The watchdog stops it (exit 3, naming the share);
-/// with `watchdog.on_dispersion = "warn"` it runs on and warns at each sample
+/// with `watchdog.on_dispersion = "warn"` it runs on and warns
 /// (and the scene's drop-shape check fails: the outline spreads over 15 dx).
 /// (With F22's interface viscosity 7.2 the same drop holds together.)
 #[test]

@@ -78,7 +78,7 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
         && m.dispersion_action() == crate::scene::DispersionAction::Warn
         && !opts.quiet
     {
-        list.push(Box::new(DispersionWarning));
+        list.push(Box::<DispersionWarning>::default());
     }
     // Where the CSF skips those particles (δ-SPH) there is nothing to warn of.
     if m.free_surface_csf() && !m.csf_skips_interior() && !opts.quiet {
@@ -127,23 +127,38 @@ impl Observer for InteriorNormals {
     }
 }
 
-/// `watchdog.on_dispersion = "warn"`: a warning at every sample at which the
-/// liquid is dispersing into its gas (crate::watchdog::dispersion); with
-/// "stop" the watchdog ends the run instead.
-struct DispersionWarning;
+/// `watchdog.on_dispersion = "warn"`: a warning at the first sample at which
+/// the liquid is dispersing into its gas, or breaking up without gas
+/// (crate::watchdog::dispersion), and again whenever the share has grown by
+/// half since the last warning (a melt track that sheds spatter for its whole
+/// run warned at each of its 18 samples); with "stop" the watchdog ends the
+/// run instead.
+#[derive(Default)]
+struct DispersionWarning {
+    /// The share at the last warning (0: none yet).
+    warned: f64,
+}
+
+/// Growth of the dispersed share that warns again.
+const DISPERSION_GROWTH: f64 = 1.5;
 
 impl Observer for DispersionWarning {
     fn observe(&mut self, m: &Model, st: &State, when: Moment) {
         if !matches!(when, Moment::Sample { .. } | Moment::Final) {
             return;
         }
-        if let Some(d) = crate::watchdog::dispersion(m, st).filter(|d| d.beyond(m)) {
-            eprintln!(
-                "warning: t = {:.6e} s: {}",
-                st.sim.time as f64,
-                d.describe(m)
-            );
+        let Some(d) = crate::watchdog::dispersion(m, st).filter(|d| d.beyond(m)) else {
+            return;
+        };
+        if d.share() < DISPERSION_GROWTH * self.warned {
+            return;
         }
+        self.warned = d.share();
+        eprintln!(
+            "warning: t = {:.6e} s: {}",
+            st.sim.time as f64,
+            d.describe(m)
+        );
     }
 }
 

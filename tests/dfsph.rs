@@ -430,3 +430,28 @@ fn a_lone_pair_meeting_at_the_support_edge_keeps_its_speed() {
         }
     }
 }
+
+/// J22 §4.2's 30 µm spread on its meltable 440C substrate, the coarse variant
+/// (D0/Δx = 15, 48 540 particles, about 75 s on 2 cores): the splat's D/D0 at
+/// 2 µs within the scene's 10% of J22's 2.00 (measured 1.955, 2.2%). This is
+/// the spread that converges to J22's figure (2.084 and 2.059 at D0/Δx = 20
+/// and 25); the 45 and 62 µm spreads stay FAIL at every resolution run (their
+/// headers give the figures and the cause), so only this one is held here.
+/// The transient sheet's D_max/D0 is printed beside 0.5 Re^0.25 (2.725 against
+/// 2.307).
+#[test]
+fn j22_spread_30um_within_10_percent_of_j22() {
+    let out = common::spatter(&[
+        "run",
+        &common::scene_at("spray/j22_spread_30um_3d"),
+        "--backend",
+        "cpu",
+    ]);
+    let (o, e) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{o}{e}");
+    let line = o.lines().find(|l| l.starts_with("check splat")).expect(&o);
+    assert!(line.ends_with("PASS"), "{line}");
+    assert!(line.contains("(tolerance 1.0000e-1)"), "{line}");
+    let summary = o.lines().find(|l| l.contains("spread factor")).expect(&o);
+    assert!(summary.contains("0.5 Re^0.25"), "{summary}");
+}

@@ -62,7 +62,13 @@ fn body_drift(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     // Its centre left the domain through an open side: it moves no more, and
     // body_place marks its members as leaving.
     if (outside_keep_box(b.x)) {
+        // It stops where it left (as its removed members do); /bodies then
+        // reads it at rest there.
         b.bonded = BODY_LEFT;
+        b.v = vec4<f32>(0.0);
+        b.l = vec4<f32>(0.0);
+        b.force = vec4<f32>(0.0);
+        b.torque = vec4<f32>(0.0);
     }
     bodies[k] = b;
 }

@@ -294,7 +294,7 @@ impl BodyTally {
     pub fn summary(&self) -> String {
         let left = match self.left {
             0 => String::new(),
-            n => format!(", {n} left the domain through an open side"),
+            n => format!(", {n} left the domain"),
         };
         format!(
             "{} rigid: {} whole, {} partly molten, {} fully molten, {} bonded into the substrate{left}",

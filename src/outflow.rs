@@ -9,7 +9,7 @@
 
 use crate::model::Model;
 use crate::scene::SIDE_NAMES;
-use crate::state::State;
+use crate::state::{State, NO_BODY};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashSet};
 
@@ -141,8 +141,20 @@ impl Outflow {
 }
 
 fn side_name(m: &Model, st: &State, i: usize) -> &'static str {
-    let (a, side, _) = m.exit_face(m.to_world(st.pos[i]));
+    let (a, side, _) = m.exit_face(exit_point(m, st, i));
     SIDE_NAMES[a][side]
+}
+
+/// Where removed particle i left, for naming its face (world coordinates): its
+/// own position, or for a member of a rigid body that left, the body's centre,
+/// which is past the face; the member itself may still stand inside the
+/// domain, nearer a closed wall than the open face (bodies::place).
+pub fn exit_point(m: &Model, st: &State, i: usize) -> [f64; 3] {
+    let k = st.body.get(st.id[i] as usize).copied().unwrap_or(NO_BODY);
+    match st.bodies.get(k as usize) {
+        Some(b) if b.left() => m.to_world(b.x),
+        _ => m.to_world(st.pos[i]),
+    }
 }
 
 /// Initial mass against the mass still in the domain plus the mass removed, each

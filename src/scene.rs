@@ -850,10 +850,13 @@ pub struct WatchdogDef {
     /// with no liquid, solid or wall particle within 1.5 Δx (alone in the gas)
     /// above which the liquid counts as dispersing into its gas (default 0.05;
     /// at least 10 such particles). A drop that holds together has none: a
-    /// splash sheds droplets of several particles.
+    /// splash sheds droplets of several particles. Without gas, under the
+    /// free-surface tension: the share in pieces too small to resolve
+    /// (crate::watchdog::fragment_limit).
     pub liquid_dispersion: f64,
     /// What a dispersing liquid does to the run: "stop" (exit 3 with the
-    /// diagnosis) or "warn" (a warning per sample). Default: "stop", "warn"
+    /// diagnosis) or "warn" (a warning at the first sample past the bound, and
+    /// again whenever the share has grown by half). Default: "stop", "warn"
     /// in scenes with a phase that melts, where a melt pool's single-particle
     /// spatter counts too (Model::dispersion_action).
     pub on_dispersion: Option<DispersionAction>,

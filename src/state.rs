@@ -234,7 +234,8 @@ pub struct Body {
 }
 
 impl Body {
-    /// Still a free body: members left and not bonded (the body passes skip the rest).
+    /// Still a free body: members remain, not bonded, not gone (the body passes
+    /// skip the rest).
     pub fn moves(&self) -> bool {
         self.count > 0 && self.bonded == 0
     }

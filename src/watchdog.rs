@@ -277,9 +277,8 @@ fn particle_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f6
 
 /// A fluid particle still in the simulation deeper behind a wall face than the
 /// watchdog allows. (One beyond an open face has been removed by the step.) A
-/// particle beyond an open face is out of the domain, where no wall stands: a
-/// rigid grain that flew out through an open top (the step removes fluid only)
-/// may drift past a side wall's line up there.
+/// particle beyond an open face is out of the domain, where no wall stands (a
+/// rigid grain's members stand there until the body's centre is out too).
 fn position_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
     let depth = m.wall_stop_depth() * m.dx;
     let faces = m.beyond_faces(m.to_world(st.pos[i]));
@@ -321,7 +320,7 @@ fn wall_trip(
 /// unless the scene's policy is "stop"; leaving behind a walled side means it went
 /// through every wall layer, which always stops the run.
 fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
-    let world = m.to_world(st.pos[i]);
+    let world = crate::outflow::exit_point(m, st, i);
     let (a, side, open) = m.exit_face(world);
     let x = world[a];
     if !open {

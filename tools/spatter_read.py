@@ -40,7 +40,7 @@ without); info["solidification"] the /solidification records as columns
 (t, x, y, z, gradient, solidification_rate, cooling_rate, ...: numpy arrays); info["track"] is the /track message of a laser scene (None
 without); info["bodies"] the /bodies messages of a scene with rigid bodies (one
 per frame: time, and per body its position, orientation, velocity, angular
-velocity, mass, particles, molten_fraction, bonded); read_vtu(path) -> {field: numpy array}.
+velocity, mass, particles, molten_fraction, bonded, left); read_vtu(path) -> {field: numpy array}.
 A file whose writer was killed (no summary) is read up to its last complete chunk.
 """
 import json

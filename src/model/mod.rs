@@ -211,7 +211,8 @@ pub const MAX_PHASES: usize = 8;
 
 impl Model {
     /// `watchdog.on_dispersion`, or its default: "warn" where a phase melts (a
-    /// melt pool under gas sheds single-particle spatter), "stop" elsewhere.
+    /// melt pool sheds spatter, single particles under gas, small pieces
+    /// without), "stop" elsewhere.
     pub fn dispersion_action(&self) -> crate::scene::DispersionAction {
         use crate::scene::DispersionAction;
         match (self.watchdog.on_dispersion, self.melts()) {

@@ -152,7 +152,10 @@ pub fn drift(pr: &Params, st: &mut State) {
         }
         rotate_free(b, dt);
         if pr.outside_keep_box(&b.x) {
+            // It stops where it left (as its removed members do); /bodies then
+            // reads it at rest there.
             b.bonded = BODY_LEFT;
+            (b.v, b.l, b.force, b.torque) = ([0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4]);
         }
     });
 }

@@ -573,13 +573,13 @@ fn wrap(c: i32, n: u32, periodic: bool) -> Option<u32> {
     }
 }
 
-/// The cell a particle sorts into; n_cells, after every cell and in none, for a
-/// fluid particle that has left the domain (issue 18). Walls stay, wherever they
-/// stand (those of a closed side reach past the open face above it).
+/// The cell a particle sorts into; n_cells, after every cell and in none, for
+/// one that has left the domain (issue 18): a fluid particle outside the keep
+/// box, or a wall-kind particle stamped with the time it left (a member of a
+/// rigid body that left, `bodies::place`; it may stand anywhere, its body's
+/// centre is past the face). Other walls stay wherever they stand (those of a
+/// closed side reach past the open face above it).
 #[inline(always)]
-/// A fluid particle outside the keep box has left; so has a wall-kind particle
-/// stamped with the time it left (a member of a rigid body that left,
-/// `bodies::place`). Either sorts after every cell, in none.
 fn cell_key(pr: &Params, p: &[f32; 4], phase: u32) -> u32 {
     let gone = if pr.is_wall(phase) {
         p[3] > 0.0

@@ -142,6 +142,18 @@ struct DispersionWarning {
 /// Growth of the dispersed share that warns again.
 const DISPERSION_GROWTH: f64 = 1.5;
 
+impl DispersionWarning {
+    /// Warn at this share (past the bound)? The first time, and then once it
+    /// has grown by DISPERSION_GROWTH since the last warning.
+    fn due(&mut self, share: f64) -> bool {
+        if share < DISPERSION_GROWTH * self.warned {
+            return false;
+        }
+        self.warned = share;
+        true
+    }
+}
+
 impl Observer for DispersionWarning {
     fn observe(&mut self, m: &Model, st: &State, when: Moment) {
         if !matches!(when, Moment::Sample { .. } | Moment::Final) {
@@ -150,10 +162,9 @@ impl Observer for DispersionWarning {
         let Some(d) = crate::watchdog::dispersion(m, st).filter(|d| d.beyond(m)) else {
             return;
         };
-        if d.share() < DISPERSION_GROWTH * self.warned {
+        if !self.due(d.share()) {
             return;
         }
-        self.warned = d.share();
         eprintln!(
             "warning: t = {:.6e} s: {}",
             st.sim.time as f64,
@@ -395,5 +406,22 @@ impl Observer for SolidificationRecords {
             sink.message(solidification::SOLIDIFICATION_TOPIC, *time, &batch)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DispersionWarning;
+
+    /// A share past the bound warns the first time, then only once it has
+    /// grown by half since the last warning (shares in the order sampled).
+    #[test]
+    fn dispersion_warns_again_only_when_the_share_grows_by_half() {
+        let mut w = DispersionWarning::default();
+        let warned: Vec<bool> = [0.06, 0.07, 0.089, 0.09, 0.12, 0.05, 0.135]
+            .iter()
+            .map(|&s| w.due(s))
+            .collect();
+        assert_eq!(warned, [true, false, false, true, false, false, true]);
     }
 }

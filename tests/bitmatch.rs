@@ -637,6 +637,80 @@ fn wetting_two_floor_phases_200_steps() {
     assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
 }
 
+/// The 2D tank of water with four rigid bodies (without its [run] table).
+const TANK_2D: &str = r#"
+[simulation]
+dimension = 2
+kernel = "quintic"
+dx = 0.01
+gravity = [0.0, -9.81]
+pressure_floor = true
+
+[domain]
+min = [0.0, 0.0]
+max = [0.4, 0.4]
+wall_phase = "wall"
+open_sides = ["y_max"]
+
+[materials.liquid]
+density = 1000.0
+viscosity = 1.0
+sound_speed = 30.0
+
+[materials.solid]
+density = 2000.0
+viscosity = 0.0
+sound_speed = 30.0
+
+[phases.water]
+kind = "liquid"
+material = "liquid"
+
+[phases.wall]
+kind = "wall"
+material = "liquid"
+
+[phases.grain]
+kind = "wall"
+material = "solid"
+
+[contact]
+stiffness = 1.0e5
+damping = 50.0
+
+[[shapes]]
+phase = "water"
+box = { min = [0.0, 0.0], max = [0.4, 0.2] }
+
+[[shapes]]
+phase = "grain"
+body = true
+box = { min = [0.05, 0.22], max = [0.1, 0.26] }
+velocity = [1.0, -0.5]
+angular_velocity = [4.0]
+
+[[shapes]]
+phase = "grain"
+body = true
+box = { min = [0.1, 0.22], max = [0.13, 0.28] }
+velocity = [-1.0, 0.0]
+angular_velocity = [-3.0]
+
+[[shapes]]
+phase = "grain"
+body = true
+sphere = { center = [0.3, 0.035], radius = 0.025 }
+velocity = [0.3, -1.0]
+
+[[shapes]]
+phase = "grain"
+body = true
+box = { min = [0.2, 0.19], max = [0.26, 0.23] }
+velocity = [0.0, -0.8]
+angular_velocity = [1.0]
+
+"#;
+
 /// Issue 17: rigid bodies in a 2D tank of water, 200 steps. Two boxes side by
 /// side spin and move into each other, a disc is thrown at the floor and a
 /// third box falls into the water: contact between bodies and with walls from
@@ -645,81 +719,8 @@ fn wetting_two_floor_phases_200_steps() {
 /// velocities.
 #[test]
 fn rigid_bodies_in_a_tank_2d_200_steps() {
-    let text = r#"
-[simulation]
-dimension = 2
-kernel = "quintic"
-dx = 0.01
-gravity = [0.0, -9.81]
-pressure_floor = true
-
-[domain]
-min = [0.0, 0.0]
-max = [0.4, 0.4]
-wall_phase = "wall"
-open_sides = ["y_max"]
-
-[materials.liquid]
-density = 1000.0
-viscosity = 1.0
-sound_speed = 30.0
-
-[materials.solid]
-density = 2000.0
-viscosity = 0.0
-sound_speed = 30.0
-
-[phases.water]
-kind = "liquid"
-material = "liquid"
-
-[phases.wall]
-kind = "wall"
-material = "liquid"
-
-[phases.grain]
-kind = "wall"
-material = "solid"
-
-[contact]
-stiffness = 1.0e5
-damping = 50.0
-
-[[shapes]]
-phase = "water"
-box = { min = [0.0, 0.0], max = [0.4, 0.2] }
-
-[[shapes]]
-phase = "grain"
-body = true
-box = { min = [0.05, 0.22], max = [0.1, 0.26] }
-velocity = [1.0, -0.5]
-angular_velocity = [4.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-box = { min = [0.1, 0.22], max = [0.13, 0.28] }
-velocity = [-1.0, 0.0]
-angular_velocity = [-3.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-sphere = { center = [0.3, 0.035], radius = 0.025 }
-velocity = [0.3, -1.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-box = { min = [0.2, 0.19], max = [0.26, 0.23] }
-velocity = [0.0, -0.8]
-angular_velocity = [1.0]
-
-[run]
-steps = 200
-"#;
-    assert_bit_identical_text("bodies_tank_2d", text, 200);
+    let text = format!("{TANK_2D}[run]\nsteps = 200\n");
+    assert_bit_identical_text("bodies_tank_2d", &text, 200);
 }
 
 /// A rigid disc thrown up through the tank's open top: body_drift marks the
@@ -728,87 +729,18 @@ steps = 200
 /// w > 0) on both twins; the other bodies carry on.
 #[test]
 fn rigid_body_leaves_through_an_open_side_2d() {
-    let text = r#"
-[simulation]
-dimension = 2
-kernel = "quintic"
-dx = 0.01
-gravity = [0.0, -9.81]
-pressure_floor = true
-
-[domain]
-min = [0.0, 0.0]
-max = [0.4, 0.4]
-wall_phase = "wall"
-open_sides = ["y_max"]
-
-[materials.liquid]
-density = 1000.0
-viscosity = 1.0
-sound_speed = 30.0
-
-[materials.solid]
-density = 2000.0
-viscosity = 0.0
-sound_speed = 30.0
-
-[phases.water]
-kind = "liquid"
-material = "liquid"
-
-[phases.wall]
-kind = "wall"
-material = "liquid"
-
-[phases.grain]
-kind = "wall"
-material = "solid"
-
-[contact]
-stiffness = 1.0e5
-damping = 50.0
-
-[[shapes]]
-phase = "water"
-box = { min = [0.0, 0.0], max = [0.4, 0.2] }
-
-[[shapes]]
-phase = "grain"
+    let text = format!(
+        "{TANK_2D}[[shapes]]
+phase = \"grain\"
 body = true
-box = { min = [0.05, 0.22], max = [0.1, 0.26] }
-velocity = [1.0, -0.5]
-angular_velocity = [4.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-box = { min = [0.1, 0.22], max = [0.13, 0.28] }
-velocity = [-1.0, 0.0]
-angular_velocity = [-3.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-sphere = { center = [0.3, 0.035], radius = 0.025 }
-velocity = [0.3, -1.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-box = { min = [0.2, 0.19], max = [0.26, 0.23] }
-velocity = [0.0, -0.8]
-angular_velocity = [1.0]
-
-[[shapes]]
-phase = "grain"
-body = true
-sphere = { center = [0.34, 0.37], radius = 0.015 }
+sphere = {{ center = [0.34, 0.37], radius = 0.015 }}
 velocity = [0.0, 4.0]
 
 [run]
 steps = 200
-"#;
-    let st = assert_bit_identical_text("bodies_leave_2d", text, 200);
+"
+    );
+    let st = assert_bit_identical_text("bodies_leave_2d", &text, 200);
     let thrown = &st.bodies[4];
     assert!(
         thrown.left(),

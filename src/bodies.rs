@@ -277,7 +277,7 @@ impl BodyTally {
             ..Default::default()
         };
         for b in &st.bodies {
-            if b.bonded == crate::state::BODY_BONDED {
+            if b.bonded_in() {
                 t.bonded += 1;
             } else if b.left() {
                 t.left += 1;

@@ -239,6 +239,10 @@ impl Body {
     pub fn moves(&self) -> bool {
         self.count > 0 && self.bonded == 0
     }
+    /// Bonded into the substrate (`BODY_BONDED`).
+    pub fn bonded_in(&self) -> bool {
+        self.bonded == BODY_BONDED
+    }
     /// Its centre left the domain through an open side (`BODY_LEFT`).
     pub fn left(&self) -> bool {
         self.bonded == BODY_LEFT

@@ -185,8 +185,13 @@ impl Dispersion {
 /// splashing, as a dam break's front does, and nothing tears its surface apart).
 pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
     let kind = |i: usize| m.phases[st.phase[i] as usize].kind;
-    let has = |k: PhaseKind| m.phases.iter().any(|p| p.kind == k);
-    if !(has(PhaseKind::Liquid) && (has(PhaseKind::Gas) || m.free_surface_csf())) {
+    let gas = !m.free_surface_interface();
+    let fragment = match (gas, m.free_surface_csf()) {
+        (true, _) => 1,
+        (false, true) => fragment_limit(m.dim),
+        (false, false) => return None,
+    };
+    if !m.phases.iter().any(|p| p.kind == PhaseKind::Liquid) {
         return None;
     }
     let dense: Vec<usize> = (0..st.active())
@@ -200,11 +205,7 @@ pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
         alone: 0,
         liquid: 0,
         first_id: u32::MAX,
-        fragment: if has(PhaseKind::Gas) {
-            1
-        } else {
-            fragment_limit(m.dim)
-        },
+        fragment,
     };
     for (k, &i) in dense.iter().enumerate() {
         if kind(i) != PhaseKind::Liquid {

@@ -416,11 +416,7 @@ impl super::Check for MeltingGrain {
             .iter()
             .map(|b| b.initial_count as u64)
             .sum::<u64>();
-        let bonded = st
-            .bodies
-            .iter()
-            .filter(|b| b.bonded == crate::state::BODY_BONDED)
-            .count();
+        let bonded = st.bodies.iter().filter(|b| b.bonded_in()).count();
         // Each particle keeps its mass, so the melt's gain is the sum of the
         // grain particles' masses: equal to the body mass at the start up to the
         // f32 rounding of that sum (relative 1e-6 for a few hundred members).

@@ -239,7 +239,7 @@ pub fn bodies_message(m: &Model, st: &State) -> serde_json::Value {
                 "mass": mo.mass,
                 "particles": b.count,
                 "molten_fraction": b.molten_fraction(),
-                "bonded": b.bonded == crate::state::BODY_BONDED,
+                "bonded": b.bonded_in(),
                 "left": b.left(),
             })
         })

@@ -26,7 +26,13 @@ const MAGIC: &[u8; 8] = b"SPATCKPT";
 // (melting bodies; version 3 bodies would recompute with zero particle inertia).
 // 5: every table of crate::fields::TABLES (bodies, members, solvers) with its
 // length in the header's `tables`; the implicit heat's heat_start field.
-const FORMAT_VERSION: u32 = 5;
+// 6: a body's bonded flag may be BODY_LEFT (2: its centre left through an open
+// side, its members stamped to leave). A version 5 binary would read that body
+// as free and move it again; version 5 files hold no such body and read as 6.
+const FORMAT_VERSION: u32 = 6;
+/// The oldest version this spatter reads: every version since has only added
+/// values the older files cannot hold.
+const OLDEST_READ: u32 = 5;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
 const KEEP: usize = 2;
@@ -162,9 +168,9 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<Checkpoint, InputError> {
     }
     let mut c = Cursor { buf: body, at: 8 };
     let version = c.u32().ok_or_else(|| bad("short file"))?;
-    if version != FORMAT_VERSION {
+    if !(OLDEST_READ..=FORMAT_VERSION).contains(&version) {
         return Err(bad(&format!(
-            "format version {version}, this spatter reads {FORMAT_VERSION}"
+            "format version {version}, this spatter reads {OLDEST_READ} to {FORMAT_VERSION}"
         )));
     }
     c.u32();
@@ -248,5 +254,41 @@ impl CheckpointSink {
             let _ = std::fs::remove_file(old);
         }
         Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{decode, FORMAT_VERSION, MAGIC, OLDEST_READ};
+
+    /// A file of the given version whose header is not JSON, with a valid CRC:
+    /// the version gate is the only check it can pass.
+    fn file_of_version(version: u32) -> Vec<u8> {
+        let mut out = MAGIC.to_vec();
+        out.extend_from_slice(&version.to_le_bytes());
+        out.extend_from_slice(&0u32.to_le_bytes());
+        out.extend_from_slice(&4u64.to_le_bytes());
+        out.extend_from_slice(b"junk");
+        out.extend_from_slice(&[0u8; 8]);
+        let crc = crc32fast::hash(&out);
+        out.extend_from_slice(&crc.to_le_bytes());
+        out
+    }
+
+    /// Version 5 files (no departed bodies) pass the gate and fail only on
+    /// their junk header; older and newer versions are refused by number.
+    #[test]
+    fn only_versions_oldest_read_to_current_pass_the_gate() {
+        for v in OLDEST_READ..=FORMAT_VERSION {
+            let e = decode("f.ckpt", &file_of_version(v)).err().unwrap();
+            assert!(e.to_string().contains("damaged header"), "{v}: {e}");
+        }
+        for v in [OLDEST_READ - 1, FORMAT_VERSION + 1] {
+            let e = decode("f.ckpt", &file_of_version(v)).err().unwrap();
+            assert!(
+                e.to_string().contains(&format!("format version {v}")),
+                "{v}: {e}"
+            );
+        }
     }
 }

@@ -124,7 +124,11 @@ pub const MIN_DISPERSED: usize = 10;
 /// by the free-surface tension's currents sheds fragments of a few particles
 /// that the tension holds together, not single particles: R = 6.25Δx of molten
 /// steel without the interface viscosity lost 73 of its 120 particles in
-/// fragments of 2 to 5, none ever alone.
+/// fragments of 2 to 5, none ever alone. A piece with a particle within a
+/// kernel support of an open side is not counted: it is leaving, or it is the
+/// last of a drop the side has cut (a free sphere drifting out of its box was
+/// stopped as "breaking up" when its last 14 particles were inside); the
+/// same holds for a particle alone in a gas.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dispersion {
     /// Liquid particles alone (with gas) or in fragments (without).
@@ -201,6 +205,14 @@ pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
     let (label, n) = crate::pool::connected_regions(&pos, crate::pool::LINK_DX * m.dx, m.dim);
     let mut size = vec![0usize; n];
     label.iter().for_each(|&r| size[r] += 1);
+    // A piece within a support of an open face is leaving through it, or is
+    // what the face has left of a drop that crossed it: not debris.
+    let mut leaving = vec![false; n];
+    for (k, x) in pos.iter().enumerate() {
+        if !leaving[label[k]] && m.near_open_face(*x, m.support) {
+            leaving[label[k]] = true;
+        }
+    }
     let mut d = Dispersion {
         alone: 0,
         liquid: 0,
@@ -212,7 +224,7 @@ pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
             continue;
         }
         d.liquid += 1;
-        if size[label[k]] <= d.fragment {
+        if size[label[k]] <= d.fragment && !leaving[label[k]] {
             d.alone += 1;
             d.first_id = d.first_id.min(st.id[i]);
         }
@@ -524,22 +536,31 @@ mod tests {
         let d = dispersion(&m, &st).unwrap();
         assert_eq!((d.alone, d.fragment), (0, 7));
         // Pieces of `size` particles in a line 1 dx apart, the pieces 4 dx
-        // apart, six to a row, below the drop (which starts 20 dx up): just
-        // over 5% of the liquid in all.
-        let pieces = |st: &mut State, size: usize| {
+        // apart, six to a row, the first row `bottom` dx up, below the drop
+        // (which starts 20 dx up): just over 5% of the liquid in all.
+        let pieces = |st: &mut State, size: usize, bottom: f64| {
             let n = (0.05 * liquid.len() as f64).ceil() as usize + size;
             for (k, &i) in liquid.iter().take(n - n % size).enumerate() {
                 let (piece, at) = (k / size, k % size);
                 let (column, row) = ((piece % 6) as f64, (piece / 6) as f64);
-                st.pos[i][0] = (m.dx * (2.0 + (size + 4) as f64 * column + at as f64)) as f32;
-                st.pos[i][1] = (m.dx * (2.0 + 4.0 * row)) as f32;
+                let x = m.dx * (5.0 + (size + 4) as f64 * column + at as f64);
+                let y = m.dx * (bottom + 4.0 * row);
+                st.pos[i][0] = (x - m.origin[0]) as f32;
+                st.pos[i][1] = (y - m.origin[1]) as f32;
             }
         };
         let mut torn = st.clone();
-        pieces(&mut torn, 7);
+        pieces(&mut torn, 7, 5.0);
         let t = scan(&m, &torn).expect("a surface breaking up");
         assert!(t.reason.contains("fragments of at most 7"), "{}", t.reason);
-        pieces(&mut st, 8);
+        // The first row 1 dx above the open y_min side, within a support of
+        // it: those six pieces are leaving, and the second row's four (28
+        // particles, 2.2%) are below the bound.
+        let mut cut = st.clone();
+        pieces(&mut cut, 7, 1.0);
+        assert_eq!(dispersion(&m, &cut).unwrap().alone, 28);
+        assert_eq!(scan(&m, &cut), None, "pieces at an open side are leaving");
+        pieces(&mut st, 8, 5.0);
         assert_eq!(scan(&m, &st), None, "pieces of 8 are droplets");
         let dam = concat!(
             env!("CARGO_MANIFEST_DIR"),

@@ -295,6 +295,16 @@ impl Model {
         out
     }
 
+    /// World point `x` lies within `within` of an open face (inside or beyond it).
+    pub fn near_open_face(&self, x: [f64; 3], within: f64) -> bool {
+        (0..self.dim as usize).any(|a| {
+            let [open_lo, open_hi] = self.open_sides[a];
+            !self.periodic[a]
+                && ((open_lo && x[a] - self.domain_lo[a] < within)
+                    || (open_hi && self.domain_hi[a] - x[a] < within))
+        })
+    }
+
     /// The face a removed particle at world point `x` left through: the one of
     /// the keep box (`keep_box`) it is farthest beyond, open or walled, as (axis,
     /// side, the side is open). The step decides removal in f32 against the same

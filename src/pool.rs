@@ -19,7 +19,6 @@
 use crate::model::Model;
 use crate::scene::PhaseKind;
 use crate::state::State;
-use std::collections::HashMap;
 
 /// Link distance between two melt particles of one region, in Δx.
 pub const LINK_DX: f64 = 1.5;
@@ -54,29 +53,58 @@ fn root(parent: &mut [usize], mut k: usize) -> usize {
 /// Connected regions of points (world coordinates): two points closer than
 /// `link` share a region. Returns each point's region label (0, 1, ...; in the
 /// order of each region's first point) and the number of regions.
+///
+/// The points are sorted by cells of side `link` (packed keys, in parallel);
+/// each cell is paired once with itself and once with each of its forward
+/// neighbours (13 in 3D, 4 in 2D), found by binary search among the occupied
+/// cells. Each sample of a run pays it on the host (the watchdog's breakup
+/// watch over every dense particle, the pool over the melt): 0.48–0.60 s for
+/// 1e6 points on a lattice (link 1.5 spacings) on 2 cores, against 1.12–1.32 s
+/// with a hash map of cells probed 27 times per point; at F22's 1.7e7
+/// particles about 10 s a sample.
 pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, usize) {
-    let cell_of = |x: &[f64; 3]| x.map(|c| (c / link).floor() as i64);
-    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-    for (k, x) in pos.iter().enumerate() {
-        cells.entry(cell_of(x)).or_default().push(k);
+    use rayon::prelude::*;
+    let coord = |x: &[f64; 3]| x.map(|c| (c / link).floor() as i64);
+    let mut order: Vec<(u64, u32)> = pos
+        .par_iter()
+        .enumerate()
+        .map(|(k, x)| (cell_key(coord(x)), k as u32))
+        .collect();
+    order.par_sort_unstable();
+    // Runs of one key: (key, start, end) in `order`.
+    let mut cells: Vec<(u64, usize, usize)> = Vec::new();
+    for (k, &(key, _)) in order.iter().enumerate() {
+        match cells.last_mut() {
+            Some(last) if last.0 == key => last.2 = k + 1,
+            _ => cells.push((key, k, k + 1)),
+        }
     }
     let mut parent: Vec<usize> = (0..pos.len()).collect();
-    let dz = if dim == 3 { -1..=1 } else { 0..=0 };
-    for (k, x) in pos.iter().enumerate() {
-        let c = cell_of(x);
-        for ox in -1..=1 {
-            for oy in -1..=1 {
-                for oz in dz.clone() {
-                    let Some(list) = cells.get(&[c[0] + ox, c[1] + oy, c[2] + oz]) else {
-                        continue;
-                    };
-                    for &j in list.iter().filter(|&&j| j > k) {
-                        let d2: f64 = (0..3).map(|a| (pos[j][a] - x[a]).powi(2)).sum();
-                        if d2 < link * link {
-                            let (a, b) = (root(&mut parent, k), root(&mut parent, j));
-                            parent[a.max(b)] = a.min(b);
-                        }
-                    }
+    let mut join = |a: usize, b: usize| {
+        let d2: f64 = (0..3).map(|c| (pos[a][c] - pos[b][c]).powi(2)).sum();
+        if d2 < link * link {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    };
+    let forward = forward_cells(dim);
+    for &(_, s, e) in &cells {
+        let points = &order[s..e];
+        for (k, &(_, a)) in points.iter().enumerate() {
+            for &(_, b) in &points[k + 1..] {
+                join(a as usize, b as usize);
+            }
+        }
+        let c = coord(&pos[points[0].1 as usize]);
+        for o in &forward {
+            let key = cell_key([c[0] + o[0], c[1] + o[1], c[2] + o[2]]);
+            let Ok(at) = cells.binary_search_by_key(&key, |cell| cell.0) else {
+                continue;
+            };
+            let (_, s2, e2) = cells[at];
+            for &(_, a) in points {
+                for &(_, b) in &order[s2..e2] {
+                    join(a as usize, b as usize);
                 }
             }
         }
@@ -93,6 +121,31 @@ pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, 
         label[k] = label[r];
     }
     (label, n)
+}
+
+/// A cell's coordinates packed 21 bits each. Cells more than 2^20 apart can
+/// share a key; the distance test keeps that from joining anything.
+fn cell_key(c: [i64; 3]) -> u64 {
+    const MASK: i64 = (1 << 21) - 1;
+    let f = |v: i64| ((v + (1 << 20)) & MASK) as u64;
+    (f(c[2]) << 42) | (f(c[1]) << 21) | f(c[0])
+}
+
+/// The neighbour cells after a cell in key order (z, then y, then x): each
+/// pair of neighbouring cells is visited once.
+fn forward_cells(dim: u32) -> Vec<[i64; 3]> {
+    let zs: &[i64] = if dim == 3 { &[-1, 0, 1] } else { &[0] };
+    let mut out = Vec::new();
+    for &z in zs {
+        for y in -1..=1 {
+            for x in -1..=1 {
+                if (z, y, x) > (0, 0, 0) {
+                    out.push([x, y, z]);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// The melt regions of `st` (empty outside heat scenes).
@@ -193,5 +246,47 @@ mod tests {
         let (label, n) = connected_regions(&pos, 1.5, 2);
         assert_eq!(n, 2);
         assert_eq!(label, vec![0, 0, 0, 0, 0, 0, 1]);
+    }
+
+    /// The cell sweep gives the regions of the all-pairs definition, on
+    /// scattered points in 2D and 3D (negative coordinates included).
+    #[test]
+    fn regions_match_every_pair_compared() {
+        for dim in [2u32, 3] {
+            let mut r = crate::random::SplitMix(7 + dim as u64);
+            let pos: Vec<[f64; 3]> = (0..1500)
+                .map(|_| {
+                    let mut x = [0.0; 3];
+                    for c in x.iter_mut().take(dim as usize) {
+                        *c = 24.0 * r.next_f64() - 12.0;
+                    }
+                    x
+                })
+                .collect();
+            let link = if dim == 3 { 1.1 } else { 0.5 };
+            let (label, n) = connected_regions(&pos, link, dim);
+            let mut parent: Vec<usize> = (0..pos.len()).collect();
+            for a in 0..pos.len() {
+                for b in a + 1..pos.len() {
+                    let d2: f64 = (0..3).map(|c| (pos[a][c] - pos[b][c]).powi(2)).sum();
+                    if d2 < link * link {
+                        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                        parent[ra.max(rb)] = ra.min(rb);
+                    }
+                }
+            }
+            let mut want = vec![usize::MAX; pos.len()];
+            let mut m = 0;
+            for k in 0..pos.len() {
+                let root = root(&mut parent, k);
+                if want[root] == usize::MAX {
+                    want[root] = m;
+                    m += 1;
+                }
+                want[k] = want[root];
+            }
+            assert!(n > 20 && n < pos.len() - 20, "dim {dim}: {n} regions");
+            assert_eq!((n, &label), (m, &want), "dim {dim}");
+        }
     }
 }

@@ -27,11 +27,11 @@ const MAGIC: &[u8; 8] = b"SPATCKPT";
 // 5: every table of crate::fields::TABLES (bodies, members, solvers) with its
 // length in the header's `tables`; the implicit heat's heat_start field.
 // 6: a body's bonded flag may be BODY_LEFT (2: its centre left through an open
-// side, its members stamped to leave). A version 5 binary would read that body
-// as free and move it again; version 5 files hold no such body and read as 6.
+// side, its members stamped to leave). A binary older than that flag would read
+// such a body as free and move it again. Version 5 files read as 6: the layout
+// is the same, and those written since the flag (6883f4b) already carry it.
 const FORMAT_VERSION: u32 = 6;
-/// The oldest version this spatter reads: every version since has only added
-/// values the older files cannot hold.
+/// The oldest version this spatter reads (same layout as the current one).
 const OLDEST_READ: u32 = 5;
 /// Checkpoints kept per folder: the newest two, in case the newest is the one
 /// a failing disk truncated.
@@ -275,7 +275,7 @@ mod tests {
         out
     }
 
-    /// Version 5 files (no departed bodies) pass the gate and fail only on
+    /// Version 5 files (the same layout) pass the gate and fail only on
     /// their junk header; older and newer versions are refused by number.
     #[test]
     fn only_versions_oldest_read_to_current_pass_the_gate() {

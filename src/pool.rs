@@ -64,6 +64,7 @@ fn root(parent: &mut [usize], mut k: usize) -> usize {
 /// particles about 10 s a sample.
 pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, usize) {
     use rayon::prelude::*;
+    assert!(pos.len() <= u32::MAX as usize, "point indices are u32");
     let coord = |x: &[f64; 3]| x.map(|c| (c / link).floor() as i64);
     let mut order: Vec<(u64, u32)> = pos
         .par_iter()
@@ -97,7 +98,7 @@ pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, 
         }
         let c = coord(&pos[points[0].1 as usize]);
         for o in &forward {
-            let key = cell_key([c[0] + o[0], c[1] + o[1], c[2] + o[2]]);
+            let key = cell_key([0, 1, 2].map(|a| c[a].wrapping_add(o[a])));
             let Ok(at) = cells.binary_search_by_key(&key, |cell| cell.0) else {
                 continue;
             };
@@ -127,7 +128,7 @@ pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, 
 /// share a key; the distance test keeps that from joining anything.
 fn cell_key(c: [i64; 3]) -> u64 {
     const MASK: i64 = (1 << 21) - 1;
-    let f = |v: i64| ((v + (1 << 20)) & MASK) as u64;
+    let f = |v: i64| (v.wrapping_add(1 << 20) & MASK) as u64;
     (f(c[2]) << 42) | (f(c[1]) << 21) | f(c[0])
 }
 
@@ -288,5 +289,27 @@ mod tests {
             assert!(n > 20 && n < pos.len() - 20, "dim {dim}: {n} regions");
             assert_eq!((n, &label), (m, &want), "dim {dim}");
         }
+    }
+
+    /// Edge cases: nothing; two points on one spot; exactly `link` apart (not
+    /// linked: the test is strict); 2^21 cells apart, where the packed cell
+    /// keys coincide (not linked); and a linked pair across the keys' wrap.
+    #[test]
+    fn regions_at_the_edges() {
+        assert_eq!(connected_regions(&[], 1.0, 3), (vec![], 0));
+        let same = [[0.5, 0.5, 0.5]; 2];
+        assert_eq!(connected_regions(&same, 1.0, 3), (vec![0, 0], 1));
+        let apart = [[0.0; 3], [1.0, 0.0, 0.0]];
+        assert_eq!(connected_regions(&apart, 1.0, 3), (vec![0, 1], 2));
+        let far = (1u64 << 21) as f64;
+        let aliased = [[0.2, 0.0, 0.0], [far + 0.3, 0.0, 0.0]];
+        assert_eq!(connected_regions(&aliased, 1.0, 3), (vec![0, 1], 2));
+        let wrap = (1u64 << 20) as f64;
+        let across = [
+            [wrap - 0.1, 0.0, 0.0],
+            [wrap + 0.1, 0.0, 0.0],
+            [1e300, 0.0, 0.0],
+        ];
+        assert_eq!(connected_regions(&across, 1.0, 3), (vec![0, 0, 1], 2));
     }
 }

@@ -125,10 +125,10 @@ pub const MIN_DISPERSED: usize = 10;
 /// that the tension holds together, not single particles: R = 6.25Δx of molten
 /// steel without the interface viscosity lost 73 of its 120 particles in
 /// fragments of 2 to 5, none ever alone. A piece with a particle within a
-/// kernel support of an open side is not counted: it is leaving, or it is the
-/// last of a drop the side has cut (a free sphere drifting out of its box was
-/// stopped as "breaking up" when its last 14 particles were inside); the
-/// same holds for a particle alone in a gas.
+/// kernel support of an open side and moving out through it is not counted:
+/// it is leaving, or it is the last of a drop the side has cut (a free sphere
+/// drifting out of its box was stopped as "breaking up" when its last 14
+/// particles were inside); the same holds for a particle alone in a gas.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dispersion {
     /// Liquid particles alone (with gas) or in fragments (without).
@@ -205,14 +205,7 @@ pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
     let (label, n) = crate::pool::connected_regions(&pos, crate::pool::LINK_DX * m.dx, m.dim);
     let mut size = vec![0usize; n];
     label.iter().for_each(|&r| size[r] += 1);
-    // A piece within a support of an open face is leaving through it, or is
-    // what the face has left of a drop that crossed it: not debris.
-    let mut leaving = vec![false; n];
-    for (k, x) in pos.iter().enumerate() {
-        if !leaving[label[k]] && m.near_open_face(*x, m.support) {
-            leaving[label[k]] = true;
-        }
-    }
+    let leaving = leaving_pieces(m, st, &dense, &pos, &label, n);
     let mut d = Dispersion {
         alone: 0,
         liquid: 0,
@@ -230,6 +223,36 @@ pub fn dispersion(m: &Model, st: &State) -> Option<Dispersion> {
         }
     }
     Some(d)
+}
+
+/// The pieces leaving through an open side: a member within a kernel support
+/// of the side and the piece's mean velocity outward through it. Such a piece
+/// is on its way out, or is what the side has left of a drop that crossed it,
+/// not debris; a piece that stays beside an open side or moves inward counts.
+fn leaving_pieces(
+    m: &Model,
+    st: &State,
+    dense: &[usize],
+    pos: &[[f64; 3]],
+    label: &[usize],
+    n: usize,
+) -> Vec<bool> {
+    let mut momentum = vec![[0.0f64; 3]; n];
+    let mut faces: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    for (k, &i) in dense.iter().enumerate() {
+        let r = label[k];
+        for a in 0..3 {
+            momentum[r][a] += st.vel[i][a] as f64;
+        }
+        for f in m.open_faces_near(pos[k], m.support) {
+            if !faces[r].contains(&f) {
+                faces[r].push(f);
+            }
+        }
+    }
+    (0..n)
+        .map(|r| faces[r].iter().any(|&(a, out)| momentum[r][a] * out > 0.0))
+        .collect()
 }
 
 fn dispersion_trip(m: &Model, st: &State) -> Option<Trip> {
@@ -554,12 +577,23 @@ mod tests {
         let t = scan(&m, &torn).expect("a surface breaking up");
         assert!(t.reason.contains("fragments of at most 7"), "{}", t.reason);
         // The first row 1 dx above the open y_min side, within a support of
-        // it: those six pieces are leaving, and the second row's four (28
-        // particles, 2.2%) are below the bound.
+        // it. At rest its six pieces count; moving down through the side they
+        // are leaving, and the second row's four (28 particles, 2.2%) are
+        // below the bound.
         let mut cut = st.clone();
         pieces(&mut cut, 7, 1.0);
+        assert!(
+            scan(&m, &cut).is_some(),
+            "pieces at rest beside a side count"
+        );
+        let near = |st: &State, i: usize| m.to_world(st.pos[i])[1] < m.support;
+        for i in 0..cut.len() {
+            if near(&cut, i) {
+                cut.vel[i][1] = -0.01;
+            }
+        }
         assert_eq!(dispersion(&m, &cut).unwrap().alone, 28);
-        assert_eq!(scan(&m, &cut), None, "pieces at an open side are leaving");
+        assert_eq!(scan(&m, &cut), None, "pieces leaving through a side");
         pieces(&mut st, 8, 5.0);
         assert_eq!(scan(&m, &st), None, "pieces of 8 are droplets");
         let dam = concat!(

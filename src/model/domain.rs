@@ -295,14 +295,20 @@ impl Model {
         out
     }
 
-    /// World point `x` lies within `within` of an open face (inside or beyond it).
-    pub fn near_open_face(&self, x: [f64; 3], within: f64) -> bool {
-        (0..self.dim as usize).any(|a| {
+    /// The open faces world point `x` lies within `within` of (inside or
+    /// beyond them), as the outward unit vectors' (axis, sign).
+    pub fn open_faces_near(&self, x: [f64; 3], within: f64) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        for a in (0..self.dim as usize).filter(|&a| !self.periodic[a]) {
             let [open_lo, open_hi] = self.open_sides[a];
-            !self.periodic[a]
-                && ((open_lo && x[a] - self.domain_lo[a] < within)
-                    || (open_hi && self.domain_hi[a] - x[a] < within))
-        })
+            if open_lo && x[a] - self.domain_lo[a] < within {
+                out.push((a, -1.0));
+            }
+            if open_hi && self.domain_hi[a] - x[a] < within {
+                out.push((a, 1.0));
+            }
+        }
+        out
     }
 
     /// The face a removed particle at world point `x` left through: the one of

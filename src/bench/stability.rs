@@ -661,12 +661,32 @@ fn run_and_judge(
                 return Err(format!("escaped the watchdog: {}", t.message()));
             }
             r.outcome = "survived".into();
+            if let Some(t) = emptied_at(&l.model, st0, st1) {
+                r.diagnosis = format!(
+                    "every fluid particle had left the domain by t = {t:.4e} s: the steps after measured nothing"
+                );
+            }
         }
     }
     if !balance.exact() {
         return Err(format!("mass not conserved: {}", balance.summary()));
     }
     Ok(())
+}
+
+/// When a run that started with fluid ends with none in the domain: the time
+/// its last fluid particle left (a removed particle's pos.w).
+fn emptied_at(m: &Model, st0: &State, st1: &State) -> Option<f64> {
+    let fluid =
+        |st: &State, i: usize| m.phases[st.phase[i] as usize].kind != scene::PhaseKind::Wall;
+    let had = (0..st0.active()).any(|i| fluid(st0, i));
+    if !had || (0..st1.active()).any(|i| fluid(st1, i)) {
+        return None;
+    }
+    (st1.active()..st1.len())
+        .filter(|&i| fluid(st1, i))
+        .map(|i| st1.pos[i][3] as f64)
+        .reduce(f64::max)
 }
 
 /// Per parameter family: the values that survived and those that stopped.
@@ -807,5 +827,31 @@ mod every_scene {
                 );
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod emptied {
+    use super::emptied_at;
+
+    /// A run whose fluid has all left says when the last of it went; one with
+    /// a fluid particle still in the domain says nothing.
+    #[test]
+    fn the_last_departure_of_a_box_left_empty() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/validation/laplace_free_disc_2d.toml"
+        );
+        let l = crate::run::load(path, &[]).unwrap();
+        let (m, st0) = (&l.model, &l.state);
+        let mut st1 = st0.clone();
+        st1.sim.removed = st1.len() as u32 - 1;
+        assert_eq!(emptied_at(m, st0, &st1), None, "one particle still in");
+        st1.sim.removed = st1.len() as u32;
+        for (k, p) in st1.pos.iter_mut().enumerate() {
+            p[3] = 0.5 + k as f32 * 1e-3;
+        }
+        let last = 0.5 + (st1.len() - 1) as f32 * 1e-3;
+        assert_eq!(emptied_at(m, st0, &st1), Some(last as f64));
     }
 }

@@ -110,11 +110,16 @@ pub fn connected_regions(pos: &[[f64; 3]], link: f64, dim: u32) -> (Vec<usize>, 
             }
         }
     }
-    // Roots are each region's lowest index: label them in index order.
-    let mut label = vec![usize::MAX; pos.len()];
+    labels(&mut parent)
+}
+
+/// Each point's region label from a union–find forest whose roots are each
+/// region's lowest index: regions numbered in index order, and their count.
+fn labels(parent: &mut [usize]) -> (Vec<usize>, usize) {
+    let mut label = vec![usize::MAX; parent.len()];
     let mut n = 0;
-    for k in 0..pos.len() {
-        let r = root(&mut parent, k);
+    for k in 0..parent.len() {
+        let r = root(parent, k);
         if label[r] == usize::MAX {
             label[r] = n;
             n += 1;
@@ -276,16 +281,7 @@ mod tests {
                     }
                 }
             }
-            let mut want = vec![usize::MAX; pos.len()];
-            let mut m = 0;
-            for k in 0..pos.len() {
-                let root = root(&mut parent, k);
-                if want[root] == usize::MAX {
-                    want[root] = m;
-                    m += 1;
-                }
-                want[k] = want[root];
-            }
+            let (want, m) = labels(&mut parent);
             assert!(n > 20 && n < pos.len() - 20, "dim {dim}: {n} regions");
             assert_eq!((n, &label), (m, &want), "dim {dim}");
         }

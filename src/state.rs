@@ -27,6 +27,15 @@ pub struct Sim {
 /// The limits' short names in code order (crate::model::limits::LIMITS).
 pub const DT_LIMIT_NAMES: [&str; 10] = crate::model::limits::LIMIT_NAMES;
 
+impl Sim {
+    /// The time at the end of the step being taken, t + Δt in f32, the
+    /// departure time a particle that leaves in this step carries in pos.w
+    /// (the WGSL twins write `sim.time + sim.dt`).
+    pub fn step_end(&self) -> f32 {
+        self.time + self.dt
+    }
+}
+
 /// Name of the limit code the timestep pass wrote.
 pub fn dt_limit_name(code: u32) -> &'static str {
     DT_LIMIT_NAMES

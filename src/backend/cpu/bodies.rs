@@ -165,7 +165,7 @@ pub fn drift(pr: &Params, st: &mut State) {
 /// sort reads as removed (`neighbors::cell_key`).
 pub fn place(st: &mut State) {
     let n = st.active();
-    let left_at = st.sim.time + st.sim.dt;
+    let left_at = st.sim.step_end();
     let (body, offset, bodies, id) = (&st.body, &st.body_offset, &st.bodies, &st.id);
     st.pos[..n].par_iter_mut().enumerate().for_each(|(i, x)| {
         let k = body[id[i] as usize];

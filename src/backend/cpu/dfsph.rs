@@ -536,7 +536,7 @@ pub fn predict(pr: &Params, st: &mut State, grid: &CellTable, table: &PairTable)
 /// `dfsph_drift`: x += Δt v*, wrapped and stamped if it left; p = ρ Σκ.
 pub fn drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
-    let left_at = st.sim.time + dt;
+    let left_at = st.sim.step_end();
     for i in fluid(pr, st) {
         let v = st.vel[i];
         let x = &mut st.pos[i];

@@ -405,7 +405,7 @@ fn impose_program(pr: &Params, ph: u32, now: f32, hv: &mut [f32; 4]) {
 /// recorded (`record_crossing`).
 pub fn temperature(pr: &Params, st: &mut State) {
     let n = st.active();
-    let now = st.sim.time + st.sim.dt;
+    let now = st.sim.step_end();
     let (time, dt) = (st.sim.time, st.sim.dt);
     let trapezoidal = pr.solve.heat_integrator == HEAT_TRAPEZOIDAL;
     let records = pr.flag(FLAG_SOLIDIFICATION);

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 pub fn kick_drift(pr: &Params, st: &mut State) {
     let dt = st.sim.dt;
     let hdt = 0.5 * dt;
-    let left_at = st.sim.time + dt;
+    let left_at = st.sim.step_end();
     let n = st.active();
     let (acc, acc_b, phase) = (&st.acc, &st.acc_b, &st.phase);
     st.pos[..n]

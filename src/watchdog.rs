@@ -241,8 +241,8 @@ fn leaving_pieces(
     let mut faces: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
     for (k, &i) in dense.iter().enumerate() {
         let r = label[k];
-        for a in 0..3 {
-            momentum[r][a] += st.vel[i][a] as f64;
+        for (p, &v) in momentum[r].iter_mut().zip(&st.vel[i]) {
+            *p += v as f64;
         }
         for f in m.open_faces_near(pos[k], m.support) {
             if !faces[r].contains(&f) {

@@ -237,12 +237,13 @@ fn leaving_pieces(
     label: &[usize],
     n: usize,
 ) -> Vec<bool> {
-    let mut momentum = vec![[0.0f64; 3]; n];
+    // Per piece, the sum of its velocities: the mean velocity's direction.
+    let mut velocity = vec![[0.0f64; 3]; n];
     let mut faces: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
     for (k, &i) in dense.iter().enumerate() {
         let r = label[k];
-        for (p, &v) in momentum[r].iter_mut().zip(&st.vel[i]) {
-            *p += v as f64;
+        for (sum, &v) in velocity[r].iter_mut().zip(&st.vel[i]) {
+            *sum += v as f64;
         }
         for f in m.open_faces_near(pos[k], m.support) {
             if !faces[r].contains(&f) {
@@ -251,7 +252,7 @@ fn leaving_pieces(
         }
     }
     (0..n)
-        .map(|r| faces[r].iter().any(|&(a, out)| momentum[r][a] * out > 0.0))
+        .map(|r| faces[r].iter().any(|&(a, out)| velocity[r][a] * out > 0.0))
         .collect()
 }
 

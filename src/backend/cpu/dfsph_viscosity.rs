@@ -48,7 +48,7 @@
 //!   so J22's value is not the scene's (issue 30's note).
 
 use super::dfsph_pairs::{for_each_pair, Pair, PairTable};
-use super::neighbors::{for_each_neighbor, CellTable, LIST_CHUNK};
+use super::neighbors::{for_each_neighbor, for_each_neighbor_among, Among, CellTable, LIST_CHUNK};
 use super::reduce::tree_total;
 use super::terms::pair_viscosity;
 use crate::backend::schedule::SolverSlot;
@@ -333,15 +333,14 @@ fn tree_dot(pr: &Params, st: &State, value: impl Fn(usize) -> [f32; 2] + Sync) -
 /// neighbours, the divisor Σ W + ε).
 pub fn wall_velocities(pr: &Params, st: &mut State, grid: &CellTable) {
     let s: &State = st;
+    // The sums want fluid neighbours only (`for_each_neighbor_among`).
+    let fluid = Among::phases(&s.phase, |p| !pr.is_wall(p));
     let rows: Vec<(usize, [f32; 4])> = (0..s.active())
         .into_par_iter()
         .filter(|&b| pr.is_wall(s.phase[b]))
         .map(|b| {
             let (mut sw, mut sv) = (0.0f32, [0.0f32; 3]);
-            for_each_neighbor(pr, &s.pos, grid, b, |j, _, r2| {
-                if pr.is_wall(s.phase[j]) {
-                    return;
-                }
+            for_each_neighbor_among(pr, &s.pos, grid, b, fluid, |j, _, r2| {
                 let wk = kernel::w(pr, r2.sqrt());
                 sw += wk;
                 let v = s.vel[j];

@@ -23,7 +23,9 @@
 //! temperature: T(h) and f_l(h) per material, linear over the melting band, and
 //!   the solid ↔ liquid switch at f_l = ½.
 
-use super::neighbors::{for_each_listed, for_each_neighbor, CellTable, NeighborList};
+use super::neighbors::{
+    for_each_listed, for_each_neighbor, for_each_neighbor_among, Among, CellTable, NeighborList,
+};
 use crate::backend::SolverSlot;
 use crate::kernel;
 use crate::params::{
@@ -49,6 +51,8 @@ fn heat_density(pr: &Params, rho: &[f32], phase: u32, i: usize) -> f32 {
 
 pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
     let (pos, phase, heat_in) = (&st.pos, &st.phase, &st.heat);
+    // The sums want conducting neighbours only (`for_each_neighbor_among`).
+    let conducting = Among::phases(phase, |p| pr.conducts(p));
     let out: Vec<Option<f32>> = (0..st.active())
         .into_par_iter()
         .map(|i| {
@@ -57,10 +61,7 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
                 return None;
             }
             let (mut sw, mut st_) = (0.0f32, 0.0f32);
-            for_each_neighbor(pr, pos, grid, i, |j, _, r2| {
-                if !pr.conducts(phase[j]) {
-                    return;
-                }
+            for_each_neighbor_among(pr, pos, grid, i, conducting, |j, _, r2| {
                 let wk = kernel::w(pr, r2.sqrt());
                 sw += wk;
                 st_ += heat_in[j][H_TEMPERATURE] * wk;

@@ -5,6 +5,7 @@
 
 use super::recorded::{Entry, RecordChunk, Recorded};
 use crate::fields::{Held, FIELDS};
+use crate::model::MAX_PHASES;
 use crate::params::Params;
 use crate::state::State;
 use rayon::prelude::*;
@@ -107,10 +108,53 @@ pub fn for_each_neighbor(
     pos: &[[f32; 4]],
     grid: &CellTable,
     i: usize,
+    f: impl FnMut(usize, [f32; 3], f32),
+) {
+    for_each_neighbor_among(pr, pos, grid, i, Among::All, f)
+}
+
+/// Which particles of a cell neighbourhood a sweep visits.
+#[derive(Clone, Copy)]
+pub enum Among<'a> {
+    All,
+    /// The particles whose phase p has bit p set in `mask`, as `phase` holds
+    /// them during one pass. `token` is unique to that pass, so that a thread's
+    /// cached copy of these candidates never outlives a phase change (melting)
+    /// under the same cell table.
+    Phases {
+        phase: &'a [u32],
+        mask: u32,
+        token: u64,
+    },
+}
+
+impl<'a> Among<'a> {
+    /// The particles of the phases `keep` selects, for one pass.
+    pub fn phases(phase: &'a [u32], keep: impl Fn(u32) -> bool) -> Self {
+        let mask = (0..MAX_PHASES as u32)
+            .filter(|&p| keep(p))
+            .fold(0, |m, p| m | 1 << p);
+        let token = GENERATION.fetch_add(1, Ordering::Relaxed);
+        Among::Phases { phase, mask, token }
+    }
+}
+
+/// `for_each_neighbor` over the particles `among` selects: the same of them,
+/// in the same order, with the same d and r², as `for_each_neighbor` gives
+/// them. The selection is made when a cell neighbourhood's candidates are
+/// gathered, so the distance sweep of each particle runs over fewer of them
+/// (for the wall pass, which wants fluid neighbours only, about half).
+#[inline(always)]
+pub fn for_each_neighbor_among(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    i: usize,
+    among: Among,
     mut f: impl FnMut(usize, [f32; 3], f32),
 ) {
     with_candidates(|near| {
-        near.sweep(pr, pos, grid, pos[i]);
+        near.sweep(pr, pos, grid, pos[i], among);
         for k in 0..near.count {
             let c = near.hits[k] as usize;
             f(
@@ -135,12 +179,12 @@ pub fn with_neighbors<R>(
     with_candidates(|near| {
         #[cfg(target_arch = "x86_64")]
         if *AVX2 && pr.sizes.flags & 7 == 0 {
-            near.gather(pr, pos, grid, &pos[i]);
+            near.gather(pr, pos, grid, &pos[i], Among::All);
             // SAFETY: the CPU has AVX2 (checked once at run time).
             let count = unsafe { near.neighbours_avx2(pr, pos[i]) };
             return f(&near.hit_j[..count], &near.hit_r2[..count]);
         }
-        near.sweep(pr, pos, grid, pos[i]);
+        near.sweep(pr, pos, grid, pos[i], Among::All);
         let count = near.count;
         for k in 0..count {
             near.hit_j[k] = near.j[near.hits[k] as usize];
@@ -255,8 +299,9 @@ fn with_candidates<R>(f: impl FnOnce(&mut Candidates) -> R) -> R {
 /// and the distances of the last swept point to them.
 #[derive(Default)]
 struct Candidates {
-    /// (CellTable::generation, cell) the copy belongs to.
-    key: (u64, usize),
+    /// (CellTable::generation, cell, 0 or `Among::Fluid`'s token) the copy
+    /// belongs to.
+    key: (u64, usize, u64),
     j: Vec<u32>,
     x: Vec<f32>,
     y: Vec<f32>,
@@ -274,8 +319,20 @@ struct Candidates {
 }
 
 impl Candidates {
-    fn gather(&mut self, pr: &Params, pos: &[[f32; 4]], grid: &CellTable, pi: &[f32; 4]) {
-        let key = (grid.generation, cell_index(pr, cell_coord(pr, pi)) as usize);
+    fn gather(
+        &mut self,
+        pr: &Params,
+        pos: &[[f32; 4]],
+        grid: &CellTable,
+        pi: &[f32; 4],
+        among: Among,
+    ) {
+        let filter = match among {
+            Among::All => 0,
+            Among::Phases { token, .. } => token,
+        };
+        let cell = cell_index(pr, cell_coord(pr, pi)) as usize;
+        let key = (grid.generation, cell, filter);
         if grid.generation != 0 && self.key == key {
             return;
         }
@@ -286,11 +343,26 @@ impl Candidates {
         self.z.clear();
         for_each_cell(pr, pi, |c| {
             let (start, end) = (grid.start[c], grid.end[c]);
-            let run = &pos[start as usize..end as usize];
-            self.j.extend(start..end);
-            self.x.extend(run.iter().map(|p| p[0]));
-            self.y.extend(run.iter().map(|p| p[1]));
-            self.z.extend(run.iter().map(|p| p[2]));
+            match among {
+                Among::All => {
+                    let run = &pos[start as usize..end as usize];
+                    self.j.extend(start..end);
+                    self.x.extend(run.iter().map(|p| p[0]));
+                    self.y.extend(run.iter().map(|p| p[1]));
+                    self.z.extend(run.iter().map(|p| p[2]));
+                }
+                Among::Phases { phase, mask, .. } => {
+                    for j in start..end {
+                        if mask.checked_shr(phase[j as usize]).unwrap_or(0) & 1 != 0 {
+                            let p = pos[j as usize];
+                            self.j.push(j);
+                            self.x.push(p[0]);
+                            self.y.push(p[1]);
+                            self.z.push(p[2]);
+                        }
+                    }
+                }
+            }
             true
         });
         let n = self.j.len();
@@ -307,8 +379,15 @@ impl Candidates {
     /// list of those with r² < support². The operations are `min_image`'s and
     /// `for_each_near`'s, so the bits are the same.
     #[inline(always)]
-    fn sweep(&mut self, pr: &Params, pos: &[[f32; 4]], grid: &CellTable, pi: [f32; 4]) {
-        self.gather(pr, pos, grid, &pi);
+    fn sweep(
+        &mut self,
+        pr: &Params,
+        pos: &[[f32; 4]],
+        grid: &CellTable,
+        pi: [f32; 4],
+        among: Among,
+    ) {
+        self.gather(pr, pos, grid, &pi, among);
         #[cfg(target_arch = "x86_64")]
         if *AVX2 {
             // SAFETY: the CPU has AVX2 (checked once at run time).

@@ -81,6 +81,34 @@ pub fn wall_temperature(pr: &Params, st: &mut State, grid: &CellTable) {
     }
 }
 
+/// What `rate` reads of every particle, computed once per particle and pass
+/// instead of once per pair (the same operations, so the same bits): the
+/// conductivity at heat.y and heat.z (0 where the phase does not conduct), and
+/// the volume m/ρ with `heat_density`.
+struct Conductors {
+    k: Vec<f32>,
+    vol: Vec<f32>,
+}
+
+impl Conductors {
+    fn new(pr: &Params, st: &State) -> Self {
+        let (rho, mass, phase, heat) = (&st.rho, &st.mass, &st.phase, &st.heat);
+        let (k, vol) = (0..st.len())
+            .into_par_iter()
+            .map(|j| {
+                let ph = phase[j];
+                let k = if pr.conducts(ph) {
+                    conductivity(pr, ph, heat[j][H_TEMPERATURE], heat[j][H_LIQUID])
+                } else {
+                    0.0
+                };
+                (k, mass[j] / heat_density(pr, rho, ph, j))
+            })
+            .unzip();
+        Conductors { k, vol }
+    }
+}
+
 /// dh_i/dt of conducting particle i at the temperatures in heat.y (and the
 /// liquid fractions in heat.z): conduction, the laser's source (W/kg), viscous
 /// heating, minus the surface losses.
@@ -90,13 +118,14 @@ fn rate(
     st: &State,
     grid: &CellTable,
     list: &NeighborList,
+    near: &Conductors,
     i: usize,
     laser_source: f32,
 ) -> f32 {
-    let (pos, rho, mass, phase, heat) = (&st.pos, &st.rho, &st.mass, &st.phase, &st.heat);
+    let (pos, rho, phase, heat) = (&st.pos, &st.rho, &st.phase, &st.heat);
     let eta2 = pr.kernel.eta2;
     let ph_i = phase[i];
-    let k_i = conductivity(pr, ph_i, heat[i][H_TEMPERATURE], heat[i][H_LIQUID]);
+    let k_i = near.k[i];
     let t_i = heat[i][H_TEMPERATURE];
     let mut sum = 0.0f32;
     for_each_listed(pr, pos, grid, list, i, |j, _, r2| {
@@ -105,7 +134,7 @@ fn rate(
         }
         let ph_j = phase[j];
         let k_ij = if pr.conducts(ph_j) {
-            let k_j = conductivity(pr, ph_j, heat[j][H_TEMPERATURE], heat[j][H_LIQUID]);
+            let k_j = near.k[j];
             // Ordered operands: i and j compute the same bits, so the
             // pair's fluxes cancel exactly in the total enthalpy.
             4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
@@ -116,7 +145,7 @@ fn rate(
         };
         let r = r2.sqrt();
         let f = kernel::dw(pr, r) * r / (r2 + eta2);
-        let v_j = mass[j] / heat_density(pr, rho, ph_j, j);
+        let v_j = near.vol[j];
         sum += v_j * k_ij * (t_i - heat[j][H_TEMPERATURE]) * f;
     });
     let mut source = laser_source;
@@ -137,6 +166,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
     let dt = st.sim.dt;
     let laser_on = pr.laser.model != 0;
     let s: &State = st;
+    let near = Conductors::new(pr, s);
     let rates: Vec<f32> = (0..s.active())
         .into_par_iter()
         .map(|i| {
@@ -148,6 +178,7 @@ pub fn conduct(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
                 s,
                 grid,
                 list,
+                &near,
                 i,
                 if laser_on { s.heat[i][H_RATE] } else { 0.0 },
             )
@@ -239,13 +270,14 @@ pub fn iterate_conduct(pr: &Params, st: &mut State, grid: &CellTable, list: &Nei
     let dt = st.sim.dt;
     let first = st.solvers[SolverSlot::Heat as usize].iterations == 0;
     let s: &State = st;
+    let near = Conductors::new(pr, s);
     let rates: Vec<f32> = (0..s.active())
         .into_par_iter()
         .map(|i| {
             if !pr.conducts(s.phase[i]) {
                 return 0.0;
             }
-            rate(pr, s, grid, list, i, s.heat_start[i][1])
+            rate(pr, s, grid, list, &near, i, s.heat_start[i][1])
         })
         .collect();
     let phase = &st.phase;

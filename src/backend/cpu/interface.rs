@@ -21,7 +21,9 @@
 //! V = m/ρ (summation density for fluids, ρ0 for solids and walls), κ_F22 the
 //! same planar-lattice normalisation of the condensed side's δ.
 
-use super::neighbors::{for_each_listed, for_each_neighbor, CellTable, NeighborList};
+use super::neighbors::{
+    for_each_listed, for_each_neighbor, min_image, with_listed, CellTable, NeighborList,
+};
 use crate::kernel;
 use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
@@ -38,26 +40,59 @@ pub fn condensed(pr: &Params, phase: u32) -> bool {
 /// simulation.
 pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     let (n, active) = (st.len(), st.active());
-    let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
-    let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
+    let (pos, phase) = (&st.pos, &st.phase);
+    // V_j once per particle, 0 for gas (not once per pair: a division).
+    let vol = condensed_volumes(pr, st);
     let gamma: Vec<f32> = (0..active)
         .into_par_iter()
         .map(|i| {
             if !condensed(pr, phase[i]) {
                 return 0.0;
             }
-            let mut g = 0.0f32;
-            for_each_listed(pr, pos, grid, list, i, |j, _, r2| {
-                if condensed(pr, phase[j]) {
-                    g += vol(j) * kernel::w(pr, r2.sqrt());
-                }
-            });
-            g
+            // Σ V_j W_ij over the condensed neighbours, eight kernels at a
+            // time, in the list's order (`kernel::sum_weighted_w`: a gas
+            // neighbour's weight is 0).
+            with_listed(pr, pos, grid, list, i, |js| {
+                PAIRS.with(|p| {
+                    let (r2, wt) = &mut *p.borrow_mut();
+                    r2.clear();
+                    wt.clear();
+                    for &j in js {
+                        let j = j as usize;
+                        let d = min_image(pr, pos[i], pos[j]);
+                        r2.push(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                        wt.push(vol[j]);
+                    }
+                    kernel::sum_weighted_w(pr, r2, wt)
+                })
+            })
         })
         .collect();
     for (s, g) in st.surface[n..n + active].iter_mut().zip(gamma) {
         *s = [g, 0.0, 0.0, 0.0];
     }
+}
+
+/// V_j = m_j/ρ0 of every condensed particle (the volume the free-surface sums
+/// weigh with), and 0 for a gas particle (which they leave out).
+fn condensed_volumes(pr: &Params, st: &State) -> Vec<f32> {
+    (0..st.len())
+        .into_par_iter()
+        .map(|j| {
+            let ph = st.phase[j];
+            if condensed(pr, ph) {
+                st.mass[j] / pr.phases[ph as usize].rho0
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+thread_local! {
+    /// `shepard`'s r² and weights of one particle's neighbours.
+    static PAIRS: std::cell::RefCell<(Vec<f32>, Vec<f32>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
 
 /// `normals`: F22's gas-interface form, or the free-surface form R18 (3.25)–(3.27)
@@ -67,9 +102,14 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
         return gas_interface(pr, st, grid);
     }
     let (n, active) = (st.len(), st.active());
-    let (pos, mass, phase, surface) = (&st.pos, &st.mass, &st.phase, &st.surface);
-    let vol = |j: usize| mass[j] / pr.phases[phase[j] as usize].rho0;
-    let gamma = |j: usize| surface[n + j][S_SHEPARD];
+    let (pos, phase, surface) = (&st.pos, &st.phase, &st.surface);
+    // V_j and 1/Γ_j once per particle instead of once per pair (divisions;
+    // the same operations, so the same bits).
+    let vol = condensed_volumes(pr, st);
+    let inv_gamma: Vec<f32> = (0..n)
+        .into_par_iter()
+        .map(|j| 1.0 / surface[n + j][S_SHEPARD])
+        .collect();
     let inv_h = pr.kernel.inv_h;
     let normals: Vec<[f32; 4]> = (0..active)
         .into_par_iter()
@@ -83,7 +123,7 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
                     return;
                 }
                 let r = r2.sqrt();
-                let f = vol(j) * (1.0 / gamma(i) + 1.0 / gamma(j)) * kernel::dw(pr, r) / r;
+                let f = vol[j] * (inv_gamma[i] + inv_gamma[j]) * kernel::dw(pr, r) / r;
                 for a in 0..3 {
                     g[a] += f * d[a];
                 }

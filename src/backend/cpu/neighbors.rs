@@ -299,7 +299,7 @@ fn with_candidates<R>(f: impl FnOnce(&mut Candidates) -> R) -> R {
 /// and the distances of the last swept point to them.
 #[derive(Default)]
 struct Candidates {
-    /// (CellTable::generation, cell, 0 or `Among::Fluid`'s token) the copy
+    /// (CellTable::generation, cell, 0 or `Among::Phases`'s token) the copy
     /// belongs to.
     key: (u64, usize, u64),
     j: Vec<u32>,

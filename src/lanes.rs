@@ -49,9 +49,9 @@ impl Lane for f32 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use avx::AVX2;
-#[cfg(target_arch = "x86_64")]
 pub(crate) use avx::F8;
+#[cfg(target_arch = "x86_64")]
+pub use avx::{AVX2, AVX512};
 
 #[cfg(target_arch = "x86_64")]
 mod avx {
@@ -64,6 +64,12 @@ mod avx {
     pub static AVX2: std::sync::LazyLock<bool> = std::sync::LazyLock::new(|| {
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("popcnt")
     });
+
+    /// Whether this CPU has AVX-512F as well (checked once): the neighbour
+    /// sweeps then compare sixteen candidates at a time and pack the hits with
+    /// one compress instruction each.
+    pub static AVX512: std::sync::LazyLock<bool> =
+        std::sync::LazyLock::new(|| *AVX2 && std::arch::is_x86_feature_detected!("avx512f"));
 
     /// Eight f32 in one AVX register. Private to the crate, whose code makes
     /// one only inside `#[target_feature(enable = "avx2")]` functions reached

@@ -5,7 +5,9 @@
 //! with Σ W_wf + ε as the divisor (see `run`), so u_w = u_wall + (u_wall Σ W − Σ u W)/(Σ W + ε).
 //! The wall's displayed density is its material's EOS inverted at p_w.
 
-use super::neighbors::{fluid_nearby, for_each_neighbor_among, Among, CellTable};
+use super::neighbors::{
+    cell_coord, cell_index, fluid_nearby, for_each_neighbor_among, Among, CellTable,
+};
 use crate::kernel;
 use crate::params::{Params, FLAG_PRESSURE_FLOOR};
 use crate::state::{State, NO_BODY};
@@ -31,73 +33,85 @@ fn run_among(pr: &Params, st: &mut State, grid: &CellTable, fluid_only: bool) {
     let (body, bodies, st_id) = (&st.body, &st.bodies, &st.id);
     let out: Vec<Option<(f32, f32, [f32; 4])>> = (0..n)
         .into_par_iter()
-        .map(|i| {
-            let ph = phase[i];
-            if !pr.is_wall(ph) {
-                return None;
-            }
-            let mut sw = 0.0f32;
-            let mut sp = 0.0f32;
-            let mut sr = [0.0f32; 3];
-            let mut sv = [0.0f32; 3];
-            // Without fluid in the cells around, the sums stay zero: skip the loop
-            // (most of a substrate in a heat scene).
-            let gather = fluid_nearby(pr, grid, &pos[i]);
-            let visit = |j: usize, d: [f32; 3], r2: f32| {
-                if pr.is_wall(phase[j]) {
-                    return;
+        // The last cell whose neighbourhood was checked for fluid: particles
+        // are sorted by cell, so consecutive wall particles share the answer.
+        .map_init(
+            || (u32::MAX, false),
+            |checked, i| {
+                let ph = phase[i];
+                if !pr.is_wall(ph) {
+                    return None;
                 }
-                let wk = kernel::w(pr, r2.sqrt());
-                sw += wk;
-                sp += p_in[j] * wk;
-                let rw = rho_in[j] * wk;
-                let v = vel_in[j];
-                for a in 0..3 {
-                    sr[a] += rw * d[a];
-                    sv[a] += v[a] * wk;
+                let mut sw = 0.0f32;
+                let mut sp = 0.0f32;
+                let mut sr = [0.0f32; 3];
+                let mut sv = [0.0f32; 3];
+                // Without fluid in the cells around, the sums stay zero: skip the loop
+                // (most of a substrate in a heat scene).
+                let cell = cell_index(pr, cell_coord(pr, &pos[i]));
+                if checked.0 != cell {
+                    *checked = (cell, fluid_nearby(pr, grid, &pos[i]));
                 }
-            };
-            if gather {
-                for_each_neighbor_among(pr, pos, grid, i, among, visit);
-            }
-            // The wall's own velocity: its phase's, or a body particle's rigid motion.
-            let mut b = pr.phase(ph).velocity.to_array();
-            let by_id = body.get(st_id[i] as usize);
-            if let Some(&k) = by_id.filter(|&&k| k != NO_BODY) {
-                let u = super::bodies::point_velocity(&bodies[k as usize], &pos[i]);
-                b = [u[0], u[1], u[2], 0.0];
-            }
-            let m = pr.phase(ph);
-            // Regularised Shepard division: Σ W + ε instead of Σ W, ε = 1e-9 W(0).
-            // At an exact lattice tie a fluid particle sits at the edge of the
-            // support, where W is 0 or a few ULP above it depending on rounding; a
-            // plain division then jumps between p = 0 (nothing gathered) and a full
-            // extrapolated pressure (tiny/tiny), and a GPU that fuses r² differently
-            // picks the other side. With ε the result goes to 0 continuously as
-            // Σ W -> 0, and for Σ W ≥ 1e-4 W(0) (every fluid neighbour closer than
-            // 2.6h with the quintic) ε changes it by at most 1e-5 relative.
-            let g = pr.flow.gravity;
-            let den = sw + pr.flow.wall_weight_floor;
-            let mut p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / den;
-            let v = [
-                b[0] + (b[0] * sw - sv[0]) / den,
-                b[1] + (b[1] * sw - sv[1]) / den,
-                b[2] + (b[2] * sw - sv[2]) / den,
-                0.0,
-            ];
-            if pr.flag(FLAG_PRESSURE_FLOOR) {
-                p = p.max(0.0);
-            }
-            Some((m.rho0 + p / m.c2, p, v))
-        })
+                let gather = checked.1;
+                let visit = |j: usize, d: [f32; 3], r2: f32| {
+                    if pr.is_wall(phase[j]) {
+                        return;
+                    }
+                    let wk = kernel::w(pr, r2.sqrt());
+                    sw += wk;
+                    sp += p_in[j] * wk;
+                    let rw = rho_in[j] * wk;
+                    let v = vel_in[j];
+                    for a in 0..3 {
+                        sr[a] += rw * d[a];
+                        sv[a] += v[a] * wk;
+                    }
+                };
+                if gather {
+                    for_each_neighbor_among(pr, pos, grid, i, among, visit);
+                }
+                // The wall's own velocity: its phase's, or a body particle's rigid motion.
+                let mut b = pr.phase(ph).velocity.to_array();
+                let by_id = body.get(st_id[i] as usize);
+                if let Some(&k) = by_id.filter(|&&k| k != NO_BODY) {
+                    let u = super::bodies::point_velocity(&bodies[k as usize], &pos[i]);
+                    b = [u[0], u[1], u[2], 0.0];
+                }
+                let m = pr.phase(ph);
+                // Regularised Shepard division: Σ W + ε instead of Σ W, ε = 1e-9 W(0).
+                // At an exact lattice tie a fluid particle sits at the edge of the
+                // support, where W is 0 or a few ULP above it depending on rounding; a
+                // plain division then jumps between p = 0 (nothing gathered) and a full
+                // extrapolated pressure (tiny/tiny), and a GPU that fuses r² differently
+                // picks the other side. With ε the result goes to 0 continuously as
+                // Σ W -> 0, and for Σ W ≥ 1e-4 W(0) (every fluid neighbour closer than
+                // 2.6h with the quintic) ε changes it by at most 1e-5 relative.
+                let g = pr.flow.gravity;
+                let den = sw + pr.flow.wall_weight_floor;
+                let mut p = (sp + (g[0] * sr[0] + g[1] * sr[1] + g[2] * sr[2])) / den;
+                let v = [
+                    b[0] + (b[0] * sw - sv[0]) / den,
+                    b[1] + (b[1] * sw - sv[1]) / den,
+                    b[2] + (b[2] * sw - sv[2]) / den,
+                    0.0,
+                ];
+                if pr.flag(FLAG_PRESSURE_FLOOR) {
+                    p = p.max(0.0);
+                }
+                Some((m.rho0 + p / m.c2, p, v))
+            },
+        )
         .collect();
-    for (i, o) in out.into_iter().enumerate() {
-        if let Some((rho, p, v)) = o {
-            st.rho[i] = rho;
-            st.press[i] = p;
-            st.vel[i] = v;
-        }
-    }
+    st.rho[..n]
+        .par_iter_mut()
+        .zip(st.press[..n].par_iter_mut())
+        .zip(st.vel[..n].par_iter_mut())
+        .zip(out.into_par_iter())
+        .for_each(|(((rho, p), v), o)| {
+            if let Some(o) = o {
+                (*rho, *p, *v) = o;
+            }
+        });
 }
 
 #[cfg(test)]

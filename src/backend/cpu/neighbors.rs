@@ -508,11 +508,7 @@ impl Candidates {
         let mut k = 0;
         while k < n {
             // Lanes past n are not loaded (masked loads) and not selected.
-            let lanes: __mmask16 = if n - k >= 16 {
-                0xffff
-            } else {
-                (1u16 << (n - k)) - 1
-            };
+            let lanes = lanes16(n - k);
             // SAFETY: the masked loads read lanes k..min(k + 16, n) only;
             // count <= k, so the stores at count end by n + 16.
             unsafe {
@@ -526,15 +522,7 @@ impl Candidates {
                 );
                 let hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(lanes, r2, s2);
                 let js = _mm512_maskz_loadu_epi32(lanes, j.as_ptr().add(k) as *const i32);
-                _mm512_storeu_si512(
-                    hit_j.as_mut_ptr().add(count) as *mut _,
-                    _mm512_maskz_compress_epi32(hit, js),
-                );
-                _mm512_storeu_ps(
-                    hit_r2.as_mut_ptr().add(count),
-                    _mm512_maskz_compress_ps(hit, r2),
-                );
-                count += hit.count_ones() as usize;
+                count += store_hits16(hit, js, r2, &mut hit_j[count..], &mut hit_r2[count..]);
             }
             k += 16;
         }
@@ -620,6 +608,43 @@ static LEFT_PACK: [[u32; 8]; 256] = {
 /// Padding the compactions need past the candidates: one AVX-512 register.
 const WIDEST: usize = 16;
 
+/// The lanes of a sixteen-lane block that lie before the end, `left`
+/// candidates away.
+#[inline(always)]
+fn lanes16(left: usize) -> u16 {
+    if left >= 16 {
+        0xffff
+    } else {
+        (1u16 << left) - 1
+    }
+}
+
+/// The lanes of `js` and `r2` that `hit` selects, packed in order to the front
+/// of `to_j` and `to_r2` (whole registers are stored: each holds at least
+/// sixteen); returns their count.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,popcnt")]
+#[inline]
+fn store_hits16(
+    hit: u16,
+    js: std::arch::x86_64::__m512i,
+    r2: std::arch::x86_64::__m512,
+    to_j: &mut [u32],
+    to_r2: &mut [f32],
+) -> usize {
+    use std::arch::x86_64::*;
+    assert!(to_j.len() >= 16 && to_r2.len() >= 16);
+    // SAFETY: both hold at least sixteen entries (checked above).
+    unsafe {
+        _mm512_storeu_si512(
+            to_j.as_mut_ptr() as *mut _,
+            _mm512_maskz_compress_epi32(hit, js),
+        );
+        _mm512_storeu_ps(to_r2.as_mut_ptr(), _mm512_maskz_compress_ps(hit, r2));
+    }
+    hit.count_ones() as usize
+}
+
 /// `compact_avx2` sixteen at a time with AVX-512F (one compress per array).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,popcnt")]
@@ -633,25 +658,13 @@ unsafe fn compact_avx512(r2: &[f32], support2: f32, hits: &mut [u32], hit_r2: &m
     let mut count = 0;
     let mut k = 0;
     while k < n {
-        let lanes: __mmask16 = if n - k >= 16 {
-            0xffff
-        } else {
-            (1u16 << (n - k)) - 1
-        };
+        let lanes = lanes16(n - k);
         // SAFETY: the masked load reads lanes k..min(k + 16, n) only; count
         // <= k, so the stores at count end by n + 16.
         unsafe {
             let v = _mm512_maskz_loadu_ps(lanes, r2.as_ptr().add(k));
             let hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(lanes, v, s2);
-            _mm512_storeu_si512(
-                hits.as_mut_ptr().add(count) as *mut _,
-                _mm512_maskz_compress_epi32(hit, base),
-            );
-            _mm512_storeu_ps(
-                hit_r2.as_mut_ptr().add(count),
-                _mm512_maskz_compress_ps(hit, v),
-            );
-            count += hit.count_ones() as usize;
+            count += store_hits16(hit, base, v, &mut hits[count..], &mut hit_r2[count..]);
         }
         base = _mm512_add_epi32(base, sixteen);
         k += 16;

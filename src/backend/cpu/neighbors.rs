@@ -610,6 +610,7 @@ const WIDEST: usize = 16;
 
 /// The lanes of a sixteen-lane block that lie before the end, `left`
 /// candidates away.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn lanes16(left: usize) -> u16 {
     if left >= 16 {

@@ -274,7 +274,7 @@ macro_rules! table {
 
 /// Every table, in checkpoint and `compare` order.
 #[rustfmt::skip]
-pub const TABLES: [TableDef; 3] = [
+pub const TABLES: [TableDef; 4] = [
     // One row per rigid body (state::Body, 32 words); the wall pass declares the
     // table in every scene, so its buffer holds one entry at least.
     table!("bodies", bodies, 32, true, "Body", Holder::Bodies, 1),
@@ -282,6 +282,9 @@ pub const TABLES: [TableDef; 3] = [
     table!("members", members, 1, false, "u32", Holder::Bodies, 0),
     // One state::Solver per solver slot (backend::schedule::SOLVER_SLOTS).
     table!("solvers", solvers, 8, false, "Solver", Holder::Solvers, 1),
+    // Ray-traced laser scenes: this step's beam power split (state::RAYS_*),
+    // integer atomics summed in any thread order.
+    table!("ray_split", laser_rays, 1, false, "atomic<u32>", Holder::Heat, 0),
 ];
 
 impl TableDef {

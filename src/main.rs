@@ -582,6 +582,26 @@ fn cmd_run(
         );
         }
     }
+    if loaded
+        .model
+        .laser
+        .as_ref()
+        .is_some_and(|l| l.rays.is_some())
+    {
+        if let Some(b) = spatter::diagnostics::LaserBalance::of(&loaded.model, &report.final_state)
+        {
+            let per = if loaded.model.dim == 2 { "/m" } else { "" };
+            println!(
+                "laser (ray-traced, last step): incident {:.4e} W{per}, absorbed {:.4e} W{per} ({:.4} of it; {:.3e} W{per} of that at the bounce limit), leaving {:.4e} W{per}; absorbed + leaving - incident = {:.1e} W{per}",
+                b.incident,
+                b.absorbed,
+                b.fraction(),
+                b.at_limit,
+                b.leaving,
+                b.absorbed + b.leaving - b.incident,
+            );
+        }
+    }
     if let Some(t) = &report.track {
         for line in t.summary(loaded.model.dim) {
             println!("{line}");

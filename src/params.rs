@@ -89,6 +89,15 @@ pub const PHASE_PROGRAM: u32 = 1 << 16;
 /// `Laser::model` codes (0: no laser).
 pub const LASER_BEER_LAMBERT: u32 = 1;
 pub const LASER_SURFACE: u32 = 2;
+pub const LASER_RAY_TRACED: u32 = 3;
+/// `Laser::profile` codes (ray-traced model).
+pub const PROFILE_GAUSSIAN: u32 = 0;
+pub const PROFILE_TOP_HAT: u32 = 1;
+/// Fixed-point units in the largest beam power of the schedule (2^31): ray
+/// powers are u32 counts, so the absorbed power of a bin is an integer sum,
+/// the same in any thread order, and every ray's split into absorbed and
+/// leaving power is exact.
+pub const RAY_UNITS_PER_PEAK: f64 = 2_147_483_648.0;
 
 gpu_struct! {
     /// Counts and scene-wide flags.
@@ -259,7 +268,7 @@ gpu_struct! {
         pub radius: f32,
         /// Absorption coefficient a (Beer–Lambert).
         pub absorption: f32,
-        /// 0 none, LASER_BEER_LAMBERT, LASER_SURFACE.
+        /// 0 none, LASER_BEER_LAMBERT, LASER_SURFACE, LASER_RAY_TRACED.
         pub model: u32,
         /// Bin size (= Δx).
         pub bin_size: f32,
@@ -275,6 +284,24 @@ gpu_struct! {
         pub lo: glam::Vec4,
         pub path_points: u32,
         pub power_steps: u32,
+        /// Ray-traced model: rays per lateral axis (odd, centred on the beam).
+        pub rays_per_side: u32,
+        /// Lateral spacing of the rays (Δx / rays_per_dx).
+        pub ray_spacing: f32,
+        /// 1 / Σ g over the bundle (g: the profile at each ray), so the rays
+        /// carry the whole beam power.
+        pub ray_norm: f32,
+        /// Surface hits a ray may make.
+        pub max_bounces: u32,
+        /// Watts per fixed-point unit (largest scheduled power / 2^31).
+        pub power_unit: f32,
+        /// PROFILE_GAUSSIAN, PROFILE_TOP_HAT.
+        pub profile: u32,
+        /// March step along a ray (Δx / 4).
+        pub march_step: f32,
+        /// Steps a ray may march between two hits (the bin box's diagonal over
+        /// the step, and one).
+        pub march_steps: u32,
         /// The arrays' own align(16) is what their 16-aligned elements imply by
         /// WGSL's rules (encase follows them); naga 30 takes a struct's alignment
         /// from its members' types and not their `@align`, so without it naga
@@ -366,6 +393,10 @@ gpu_struct! {
         /// `conductivity_table` (0: none): λ_k and the slope to the next point
         /// (the last: 0, held).
         pub conductivity_points: u32,
+        /// Ray-traced laser: the complex refractive index (n, k) of an
+        /// absorbing phase at the laser's wavelength (0 elsewhere).
+        pub optical_n: f32,
+        pub optical_k: f32,
         pub density: [LawPoints; 2],
         pub enthalpy: [LawPoints; 2],
         pub conductivity_law: [LawPoints; 2],
@@ -680,6 +711,14 @@ impl Params {
             }
         }
         p.laser = laser_block(m);
+        if let Some(r) = m.laser.as_ref().and_then(|l| l.rays.as_ref()) {
+            for (i, nk) in r.optics.iter().enumerate() {
+                if let Some((n, k)) = nk {
+                    p.phases[i].optical_n = *n as f32;
+                    p.phases[i].optical_k = *k as f32;
+                }
+            }
+        }
         if let Some(c) = m.contact.filter(|_| m.has_bodies()) {
             p.sizes.flags |= FLAG_BODIES;
             p.bodies = Bodies {
@@ -1053,8 +1092,9 @@ fn laser_block(m: &Model) -> Laser {
     p.model = match l.model {
         crate::scene::LaserModel::BeerLambert => LASER_BEER_LAMBERT,
         crate::scene::LaserModel::GaussianSurface => LASER_SURFACE,
+        crate::scene::LaserModel::RayTraced => LASER_RAY_TRACED,
     };
-    p.absorptivity = l.absorptivity as f32;
+    p.absorptivity = l.absorptivity.unwrap_or(0.0) as f32;
     p.radius = l.radius as f32;
     p.absorption = l.absorption as f32;
     let peak = if m.dim == 3 {
@@ -1096,7 +1136,59 @@ fn laser_block(m: &Model) -> Laser {
             power: *pw as f32,
         };
     }
+    if let Some(r) = &l.rays {
+        ray_block(&mut p, m, l, r);
+    }
     p
+}
+
+/// Watts per fixed-point count of the ray-traced laser: the schedule's largest
+/// power over 2^31 (RAY_UNITS_PER_PEAK), as the device holds it.
+pub fn ray_power_unit(l: &crate::model::Laser) -> f32 {
+    let peak = l.power.iter().map(|q| q.1).fold(0.0, f64::max);
+    let peak = if peak > 0.0 { peak } else { 1.0 };
+    (peak / RAY_UNITS_PER_PEAK) as f32
+}
+
+/// The ray-traced model's bundle: its count, spacing, the weights' normalisation
+/// (Σ g over the same offsets the passes evaluate, in f64) and the march.
+fn ray_block(p: &mut Laser, m: &Model, l: &crate::model::Laser, r: &crate::model::RayTracing) {
+    let n = r.rays_per_side(m.dx, l.radius);
+    let spacing = m.dx / r.rays_per_dx as f64;
+    p.rays_per_side = n;
+    p.ray_spacing = spacing as f32;
+    p.max_bounces = r.max_bounces;
+    p.profile = match r.profile {
+        crate::scene::BeamProfile::Gaussian => PROFILE_GAUSSIAN,
+        crate::scene::BeamProfile::TopHat => PROFILE_TOP_HAT,
+    };
+    let half = (n / 2) as i64;
+    let rw = l.radius;
+    let g = |o: f64| -> f64 {
+        match r.profile {
+            crate::scene::BeamProfile::Gaussian => (-2.0 * o / (rw * rw)).exp(),
+            crate::scene::BeamProfile::TopHat => (o <= rw * rw) as u8 as f64,
+        }
+    };
+    let offsets: Vec<f64> = (-half..=half).map(|k| k as f64 * spacing).collect();
+    let mut sum = 0.0;
+    for &a in &offsets {
+        if m.dim == 3 {
+            for &b in &offsets {
+                sum += g(a * a + b * b);
+            }
+        } else {
+            sum += g(a * a);
+        }
+    }
+    p.ray_norm = (1.0 / sum) as f32;
+    p.power_unit = ray_power_unit(l);
+    p.march_step = (0.25 * m.dx) as f32;
+    let diagonal: f64 = (0..m.dim as usize)
+        .map(|a| (p.bins[a] as f64 * m.dx).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    p.march_steps = (diagonal / (0.25 * m.dx)).ceil() as u32 + 1;
 }
 
 fn finite_or_max(v: f64) -> f32 {

@@ -354,6 +354,22 @@ pub enum LaserModel {
     BeerLambert,
     /// Gaussian flux through the surface F22 (17): ζ ⟨−n·e_l⟩ s_l(x) δ.
     GaussianSurface,
+    /// The beam as a bundle of rays, each absorbed at the surface it meets by
+    /// the Fresnel absorptivity of the material's optical constants at the angle
+    /// of incidence, and reflected specularly on (docs/physics.md, "Ray-traced
+    /// absorption").
+    RayTraced,
+}
+
+/// `laser.profile`: the beam's irradiance across its radius (ray-traced model).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BeamProfile {
+    /// exp(−2 r²/r_w²), `radius` the 1/e² radius r_w (= D4σ / 2).
+    #[default]
+    Gaussian,
+    /// Uniform out to `radius`, nothing beyond.
+    TopHat,
 }
 
 /// `laser.power`: one number, or a [time, power] schedule.
@@ -369,10 +385,25 @@ pub enum PowerDef {
 #[serde(deny_unknown_fields)]
 pub struct LaserDef {
     pub model: LaserModel,
-    /// Absorptivity ζ: the fraction of the beam power the material can take up.
-    pub absorptivity: f64,
-    /// Beam radius r_w (m): irradiance ∝ exp(−2 r²/r_w²), d_w = 2 r_w (F22 (17)).
+    /// Absorptivity ζ: the fraction of the beam power the material can take up
+    /// (`beer_lambert`, `gaussian_surface`; the ray-traced model takes it from
+    /// the materials' optical constants instead).
+    pub absorptivity: Option<f64>,
+    /// Beam radius r_w (m): irradiance ∝ exp(−2 r²/r_w²), d_w = 2 r_w (F22 (17));
+    /// D4σ = 2 r_w. A top-hat beam's edge radius.
     pub radius: f64,
+    /// Ray-traced model: `gaussian` (default) or `top_hat`.
+    #[serde(default)]
+    pub profile: BeamProfile,
+    /// Ray-traced model: rays per Δx across the beam (default 2: a ray every
+    /// Δx/2 laterally, out to 2 r_w).
+    pub rays_per_dx: Option<u32>,
+    /// Ray-traced model: surface hits a ray may make (default 8); the power a
+    /// ray still carries after its last is absorbed there, and reported.
+    pub max_bounces: Option<u32>,
+    /// Laser wavelength (m): needed where a material gives its optics as an
+    /// electrical resistivity (Hagen–Rubens).
+    pub wavelength: Option<f64>,
     /// Beer–Lambert absorption coefficient (1/m).
     pub absorption_coefficient: Option<f64>,
     /// Beam power (W; W per metre of depth in 2D): one number, held from t = 0,
@@ -386,6 +417,31 @@ pub struct LaserDef {
     /// Scan path: [time, x] (2D) or [time, x, y] (3D) beam centres, linear in
     /// between and held before the first and after the last.
     pub path: Vec<Vec<f64>>,
+}
+
+/// `simulation.interface_viscosity`: α at this Δx, or α at a reference Δx.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum InterfaceViscosityDef {
+    Alpha(f64),
+    Scaled { alpha: f64, at_dx: f64 },
+}
+
+impl Default for InterfaceViscosityDef {
+    fn default() -> Self {
+        InterfaceViscosityDef::Alpha(0.0)
+    }
+}
+
+impl InterfaceViscosityDef {
+    /// α at resolution dx (NaN for a reference Δx that is not positive).
+    pub fn alpha(&self, dx: f64) -> f64 {
+        match *self {
+            InterfaceViscosityDef::Alpha(a) => a,
+            InterfaceViscosityDef::Scaled { alpha, at_dx } if at_dx > 0.0 => alpha * at_dx / dx,
+            InterfaceViscosityDef::Scaled { .. } => f64::NAN,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -424,9 +480,12 @@ pub struct Simulation {
     #[serde(default)]
     pub initial_pressure: InitialPressure,
     /// F22 (31)–(32) liquid–gas interface viscosity α_0^lg (0 = off; F22 Table 1,
-    /// molten steel: 7.2; Table 4, liquid binder: 1.8). Needs a liquid and a gas phase.
+    /// molten steel: 7.2; Table 4, liquid binder: 1.8), at a liquid's surface with
+    /// gas or free. A number is α at this Δx; `{ alpha = 7.2, at_dx = 1.6667e-6 }`
+    /// is α at a reference Δx (F22's), scaled as at_dx/Δx so that the damping
+    /// viscosity α h c / (2(d + 2)) it adds stays the same when Δx changes.
     #[serde(default)]
-    pub interface_viscosity: f64,
+    pub interface_viscosity: InterfaceViscosityDef,
     /// F22 (33) solid–fluid artificial viscosity: α_i^sf = coefficient ×
     /// f̄[T_i, T_s, T_s + width] on particles of melting liquids (T_s their
     /// solidus), in the form of F22 (31) (F22 Table 1: 1.0 and 300 K).
@@ -645,6 +704,13 @@ pub struct Material {
     /// temperature, linear between them and held at the end values beyond.
     /// Replaces `conductivity` and `liquid_conductivity`.
     pub conductivity_table: Option<Vec<Vec<f64>>>,
+    /// Complex refractive index [n, k] at the laser's wavelength (ray-traced
+    /// laser): the Fresnel absorptivity of a surface at any angle follows.
+    pub refractive_index: Option<Vec<f64>>,
+    /// DC electrical resistivity ρ_e (Ω m), the alternative to
+    /// `refractive_index`: n = k = 1/√(2 ε0 ω ρ_e) (Hagen–Rubens, the Drude
+    /// model's low-frequency limit; needs `laser.wavelength`).
+    pub electrical_resistivity: Option<f64>,
 }
 
 /// F22 Table 1 names: p_v(T) = C_p exp[−C_T (1/T − 1/T_v)], ṁ = 0.82 c_s p_v √(C_M/T),
@@ -953,6 +1019,70 @@ pub struct CheckDef {
     pub ejected: Option<usize>,
     /// binder: the binder must still move down at the end.
     pub sinking: Option<bool>,
+    /// measured_track: the measured melt-pool figures and where the track is
+    /// steady.
+    pub measured: Option<MeasuredTrackDef>,
+}
+
+/// `[check.measured]` of `measured_track`: a laser track's melt pool as
+/// measured (width and depth from cross-sections of the solidified track,
+/// length from thermography of the moving pool), each with its tolerance.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasuredTrackDef {
+    /// m.
+    pub width: f64,
+    pub depth: f64,
+    pub length: f64,
+    /// [x0, x1] (m): the track's steady part, where width and depth are
+    /// averaged over the slices and the pool's length over the samples with the
+    /// beam centre inside it.
+    pub steady: Vec<f64>,
+    /// Relative tolerance of width and depth (default 0.10).
+    pub width_depth_tolerance: Option<f64>,
+    /// Relative tolerance of the length (default 0.20: thermography's
+    /// emissivity makes it the least certain).
+    pub length_tolerance: Option<f64>,
+}
+
+impl MeasuredTrackDef {
+    pub const WIDTH_DEPTH_TOLERANCE: f64 = 0.10;
+    pub const LENGTH_TOLERANCE: f64 = 0.20;
+    /// Its own keys' validation (exit 2 naming the key).
+    pub fn validate(&self, file: &str, dim: u32) -> Result<(), crate::error::InputError> {
+        let err = |k: &str, m: String| {
+            crate::error::InputError::new(file, &format!("check.measured.{k}"), m)
+        };
+        for (k, v) in [
+            ("width", self.width),
+            ("depth", self.depth),
+            ("length", self.length),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(err(k, format!("must be a positive length in m (got {v})")));
+            }
+        }
+        if dim != 3 {
+            return Err(err(
+                "width",
+                "a measured track's width needs a 3D scene".into(),
+            ));
+        }
+        if self.steady.len() != 2 || !(self.steady[0] < self.steady[1]) {
+            return Err(err("steady", "expected [x0, x1] with x0 < x1 (m)".into()));
+        }
+        for (k, v) in [
+            ("width_depth_tolerance", self.width_depth_tolerance),
+            ("length_tolerance", self.length_tolerance),
+        ] {
+            if let Some(t) = v {
+                if !(t.is_finite() && t > 0.0 && t < 1.0) {
+                    return Err(err(k, format!("a relative tolerance in (0, 1) (got {t})")));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
@@ -1059,6 +1189,9 @@ pub enum CheckKind {
     /// F22 §4.2, binder jetting: the binder's penetration into the bed and
     /// its spread against a slower drop's, binder at the walls, ejected grains.
     Binder,
+    /// A laser track's melt pool (width, depth, length) against a measured one
+    /// (`[check.measured]`); counts the figures outside their tolerance.
+    MeasuredTrack,
 }
 
 /// `check.fraction` of `drop_contact`: which share of the first drop it measures.
@@ -1110,6 +1243,7 @@ impl CheckKind {
             CheckKind::PointMelt => "point_melt",
             CheckKind::Deposition => "deposition",
             CheckKind::Binder => "binder",
+            CheckKind::MeasuredTrack => "measured_track",
         }
     }
 }

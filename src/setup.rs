@@ -422,6 +422,9 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
     if held.solvers {
         st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];
     }
+    if m.laser.as_ref().is_some_and(|l| l.rays.is_some()) {
+        st.laser_rays = vec![0; 4];
+    }
     Ok(st)
 }
 

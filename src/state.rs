@@ -101,6 +101,11 @@ pub struct State {
     /// solver slot (backend::schedule::SOLVER_SLOTS), this step's iterations,
     /// flag and residual.
     pub solvers: Vec<Solver>,
+    /// Ray-traced laser scenes (empty otherwise): this step's beam power in
+    /// fixed-point units (`Params::laser.power_unit` W each), [incident,
+    /// absorbed, leaving the domain, absorbed at the bounce limit]; incident =
+    /// absorbed + leaving exactly (`laser.wgsl`, `cpu/laser.rs`).
+    pub laser_rays: Vec<u32>,
     /// Scenes with a phase that melts, and heat (empty otherwise), 2n entries
     /// indexed by particle id (`solidification[id]`, `solidification[n + id]`),
     /// not sorted: the record of the particle's last liquidus crossing on cooling
@@ -155,6 +160,11 @@ pub const H_ENTHALPY: usize = 0;
 pub const H_TEMPERATURE: usize = 1;
 pub const H_LIQUID: usize = 2;
 pub const H_RATE: usize = 3;
+/// Slots of `State::laser_rays`.
+pub const RAYS_INCIDENT: usize = 0;
+pub const RAYS_ABSORBED: usize = 1;
+pub const RAYS_LEAVING: usize = 2;
+pub const RAYS_AT_LIMIT: usize = 3;
 /// `surface[i]` is (outward normal xyz, surface delta δ); `surface[n + i]` is
 /// (Shepard sum Γ, curvature κ, the free-surface form's raw κ, thin-layer flag: R18 §4.4).
 pub const S_DELTA: usize = 3;

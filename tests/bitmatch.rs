@@ -575,6 +575,70 @@ fn line_melt_with_every_force_200_steps() {
     assert!(thin > 0, "no particle of a thin layer at step 200");
 }
 
+/// The ray-traced laser (Fresnel absorption with reflections) in the line melt
+/// with every force, as above, 200 steps: the plate melts and its surface
+/// moves under the rays; the bins' integer counts make each bin's power the
+/// same in any thread order.
+#[test]
+fn line_melt_with_ray_traced_laser_200_steps() {
+    let text = ray_traced(
+        &std::fs::read_to_string(format!(
+            "{}/scenarios/pbf/line_melt_coarse_2d.toml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+    );
+    let sets = [
+        "phases.plate.temperature=1650.0",
+        "laser.power=[[0.0, 4.0e6]]",
+    ];
+    let st = bit_identical_text_with("line_melt_ray_traced", &text, &sets, 200);
+    let c = &st.laser_rays;
+    assert!(c[spatter::state::RAYS_ABSORBED] > 0, "{c:?}");
+    assert_eq!(
+        c[spatter::state::RAYS_INCIDENT] as u64,
+        c[spatter::state::RAYS_ABSORBED] as u64 + c[spatter::state::RAYS_LEAVING] as u64
+    );
+    assert!(st.heat.iter().any(|h| h[2] > 0.0), "nothing melted");
+}
+
+/// The same on the small 3D melt block, 200 steps.
+#[test]
+fn melt_block_3d_ray_traced_200_steps() {
+    let text = ray_traced(&melt_block_small_3d());
+    assert_bit_identical_text("melt_block_small_3d_ray_traced", &text, 200);
+}
+
+/// A laser scene's text with the ray-traced model in place of its own: its
+/// absorptivity line and its check (which compare with a fixed ζ) go, and each
+/// material takes nickel's (n, k) at 1.07 µm.
+fn ray_traced(text: &str) -> String {
+    let mut out = String::new();
+    let mut in_check = false;
+    for line in text.lines() {
+        let t = line.trim_start();
+        if t.starts_with('[') {
+            in_check = t.starts_with("[check]");
+        }
+        if in_check || t.starts_with("absorptivity") || t.starts_with("absorption_coefficient") {
+            continue;
+        }
+        if t.starts_with("model = \"gaussian_surface\"")
+            || t.starts_with("model = \"beer_lambert\"")
+        {
+            out.push_str("model = \"ray_traced\"\n");
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+        if t.starts_with("[materials.") {
+            out.push_str("refractive_index = [2.88, 5.26]\n");
+        }
+    }
+    assert!(out.contains("ray_traced"), "no laser model to replace");
+    out
+}
+
 /// Issue 16 item 3: wetting by a prescribed normal (F22 (27)–(29)), the sessile
 /// drop at 60° spreading on its wall, 200 steps.
 #[test]
@@ -1095,4 +1159,26 @@ fn timestep_lands_on_the_end_time_on_both_twins() {
         assert!(shortened >= 8, "{sets:?}: {shortened} shortened steps");
         assert!(st.sim.time > end, "{sets:?}: the steps after the end go on");
     }
+}
+
+/// The ray-traced laser's reflections: a 90° groove in the nickel plate (its
+/// particles handed to the non-absorbing wall phase), the beam on its left
+/// wall, so every ray reflects across and hits the right wall (tests/laser_rays.rs
+/// checks the total against Fresnel), 20 steps.
+#[test]
+fn ray_traced_groove_reflections_20_steps() {
+    let path = common::scene("laser_ray_plate");
+    let l = load(&path, &[]).unwrap();
+    let id = |name: &str| l.model.phases.iter().position(|p| p.name == name).unwrap() as u32;
+    let (plate, void) = (id("plate"), id("insulation"));
+    let sets = ["laser.radius=1.5e-5", "laser.path=[[0.0, 1.6e-4]]"];
+    let st = bit_identical_prepared(&path, &sets, 20, |st| {
+        for i in 0..st.len() {
+            let p = st.pos[i];
+            if st.phase[i] == plate && p[1] > 7.0e-5 + (p[0] - 2.0e-4).abs() {
+                st.phase[i] = void;
+            }
+        }
+    });
+    assert!(st.laser_rays[spatter::state::RAYS_ABSORBED] > 0);
 }

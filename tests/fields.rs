@@ -117,6 +117,7 @@ fn every_buffer_has_its_rows_element_type() {
         let size = match elem(t.name) {
             naga::TypeInner::Struct { span, .. } => span as usize,
             naga::TypeInner::Scalar(s) => s.width as usize,
+            naga::TypeInner::Atomic(s) => s.width as usize,
             other => panic!("{}: {other:?}", t.name),
         };
         assert_eq!(size, 4 * t.components, "{}", t.name);

@@ -52,3 +52,36 @@ fn portable_math_bit_identical_on_software_adapter() {
         }
     }
 }
+
+/// The ray-traced laser's Fresnel absorptivity (lib/math.wgsl `fresnel`, twin
+/// `backend::cpu::laser::fresnel`) gives the same bits on the software adapter
+/// over metals' and dielectrics' indices and every incidence. Written as
+/// (n² − s²) − k²: lavapipe reassociates n² − k² − s².
+#[test]
+fn fresnel_bit_identical_on_software_adapter() {
+    std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
+        .expect("a Vulkan adapter (the test command installs lavapipe)");
+    assert!(ctx.is_software(), "bit-match needs the software adapter");
+    let mut params = Params::zeroed();
+    params.consts = SHADER_CONSTS;
+    let mut seed = 11u64;
+    let n = 1 << 14;
+    let ns: Vec<f32> = (0..n).map(|_| 0.1 + 6.0 * lcg(&mut seed)).collect();
+    let ks: Vec<f32> = (0..n).map(|_| 8.0 * lcg(&mut seed)).collect();
+    let cs: Vec<f32> = (0..n).map(|_| lcg(&mut seed)).collect();
+    let gpu = eval_f32(&ctx, &params, "fresnel(a, b, c)", &ns, &ks, &cs);
+    for i in 0..n {
+        let cpu = spatter::backend::cpu::laser::fresnel(ns[i], ks[i], cs[i]);
+        assert_eq!(
+            gpu[i].to_bits(),
+            cpu.to_bits(),
+            "fresnel({}, {}, {}): gpu {:e} cpu {:e}",
+            ns[i],
+            ks[i],
+            cs[i],
+            gpu[i],
+            cpu
+        );
+    }
+}

@@ -297,3 +297,64 @@ fn binder_scenes_validate_and_their_check_keys_exit_2() {
         "check.kind",
     );
 }
+
+/// NIST AM-Bench AMB2018-02's three tracks (IN625, ray-traced absorption;
+/// their coarse runs take 15-60 minutes on 2 cores, so run by hand: figures
+/// in docs/validation.md). Each validates without a warning at its own Δx and
+/// at the coarse one, states its cost as a GPU job, and its measured-track keys
+/// exit 2; the interface viscosity given at F22's Δx scales with Δx, so
+/// `--set dx=` alone changes the resolution.
+#[test]
+fn amb2018_02_scenes_validate_and_their_check_keys_exit_2() {
+    for case in ["a", "b", "c"] {
+        let scene = common::scene_at(&format!("pbf/amb2018_02_{case}"));
+        for sets in [&[][..], &["--set", "dx=2e-5"][..]] {
+            let mut args = vec!["validate", scene.as_str()];
+            args.extend_from_slice(sets);
+            let out = common::spatter(&args);
+            let (o, e) = common::text(&out);
+            assert_eq!(out.status.code(), Some(0), "{case} {sets:?}: {o}{e}");
+            assert!(!o.contains("warning"), "{case} {sets:?}: {o}");
+            assert!(o.contains("on one H100"), "{case}: {o}");
+        }
+        for (set, key) in [
+            ("check.measured.width=-1.0", "check.measured.width"),
+            (
+                "check.measured.steady=[2.0e-3, 1.0e-3]",
+                "check.measured.steady",
+            ),
+            (
+                "check.measured.length_tolerance=1.5",
+                "check.measured.length_tolerance",
+            ),
+            ("laser.absorptivity=0.35", "laser.absorptivity"),
+        ] {
+            common::assert_input_error(&["validate", &scene, "--set", set], key);
+        }
+    }
+    // α = 7.2 at F22's Δx = 1.6667 µm is 0.6 at 20 µm and 1.2 at 10 µm: the
+    // model's α (and so the damping viscosity α h c / (2(d + 2)), h = Δx) follows.
+    let scene = common::scene_at("pbf/amb2018_02_c");
+    for (dx, alpha) in [(2.0e-5, 0.6), (1.0e-5, 1.2)] {
+        let set = format!("dx={dx}");
+        let l = spatter::run::load(&scene, &[set]).unwrap();
+        assert!(
+            (l.model.interface_viscosity - alpha).abs() < 1e-3 * alpha,
+            "{dx}: {}",
+            l.model.interface_viscosity
+        );
+    }
+    // A sound speed too low for the recoil is warned about, naming the key.
+    let out = common::spatter(&[
+        "validate",
+        &scene,
+        "--set",
+        "materials.in625.reference_pressure=2.0e5",
+    ]);
+    let (o, e) = common::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{o}{e}");
+    assert!(
+        format!("{o}{e}").contains("materials.in625.sound_speed"),
+        "{o}{e}"
+    );
+}

@@ -98,3 +98,17 @@ fn solve_symmetric(xx: f32, xy: f32, xz: f32, yy: f32, yz: f32, zz: f32, b: vec3
     }
     return g;
 }
+
+// Fresnel absorptivity 1 - (R_s + R_p)/2, unpolarised, index n + ik, incidence cosine.
+fn fresnel(n: f32, k: f32, cos_in: f32) -> f32 {
+    let c = clamp(cos_in, 1e-6, 1.0);
+    let s2 = c_one() - c * c;
+    let a_ = (n * n - s2) - k * k; // this order: lavapipe reassociates n*n - k*k - s2
+    let b_ = sqrt(a_ * a_ + c_four() * (n * n) * (k * k));
+    let a = sqrt(c_half() * (b_ + a_));
+    let b2 = c_half() * (b_ - a_);
+    let rs = ((a - c) * (a - c) + b2) / ((a + c) * (a + c) + b2);
+    let st = s2 / c;
+    let rp = rs * (((a - st) * (a - st) + b2) / ((a + st) * (a + st) + b2));
+    return c_one() - c_half() * (rs + rp);
+}

@@ -89,7 +89,7 @@ struct Laser {
     absorptivity: f32,
     radius: f32,
     absorption: f32,         // Beer-Lambert absorption coefficient
-    model: u32,              // 0 none, LASER_BEER_LAMBERT, LASER_SURFACE
+    model: u32,              // 0 none, LASER_BEER_LAMBERT, LASER_SURFACE, LASER_RAY_TRACED
     bin_size: f32,
     peak_per_watt: f32,      // peak irradiance per watt
     bin_volume: f32,
@@ -98,6 +98,14 @@ struct Laser {
     lo: vec4<f32>,           // bin grid lower corner (grid-relative)
     path_points: u32,
     power_steps: u32,
+    rays_per_side: u32,      // ray-traced: rays per lateral axis (odd)
+    ray_spacing: f32,        // their lateral spacing
+    ray_norm: f32,           // 1 / sum of the profile over the bundle
+    max_bounces: u32,        // surface hits a ray may make
+    power_unit: f32,         // W per fixed-point unit
+    profile: u32,            // PROFILE_GAUSSIAN, PROFILE_TOP_HAT
+    march_step: f32,         // step along a ray
+    march_steps: u32,        // steps a ray may march between two hits
     // @align(16): naga takes a struct's alignment from its members' types, not
     // their @align, so PathPoint's own would not place the array (params.rs).
     @align(16) path: array<PathPoint, 8>,
@@ -170,6 +178,8 @@ struct Phase {
     implicit_eta: f32,       // DFSPH implicit viscosity's mu (eta is then 0)
     enthalpy_points: u32,    // enthalpy_table (0: none): h - h(T_ref) at point k is enthalpy[k / 4].value[k % 4]
     conductivity_points: u32, // conductivity_table (0: none), in conductivity_law
+    optical_n: f32,          // ray-traced laser: complex refractive index n + ik
+    optical_k: f32,
     density: array<LawPoints, 2>,
     enthalpy: array<LawPoints, 2>,
     conductivity_law: array<LawPoints, 2>,
@@ -335,6 +345,9 @@ const PHASE_DENSITY_LAW: u32 = 32768u;
 const PHASE_PROGRAM: u32 = 65536u;
 const LASER_BEER_LAMBERT: u32 = 1u;
 const LASER_SURFACE: u32 = 2u;
+const LASER_RAY_TRACED: u32 = 3u;
+const PROFILE_GAUSSIAN: u32 = 0u;
+const PROFILE_TOP_HAT: u32 = 1u;
 const HEAT_EULER: u32 = 0u;
 const HEAT_TRAPEZOIDAL: u32 = 1u;
 const SOLVER_HEAT: u32 = 0u;

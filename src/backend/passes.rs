@@ -8,7 +8,8 @@ use super::schedule::SolverSlot;
 use crate::params::{
     Params, FLAG_BODIES, FLAG_COLOUR_TENSION, FLAG_CONTINUITY, FLAG_FREE_SURFACE_TENSION,
     FLAG_GAS_INTERFACE, FLAG_HEAT, FLAG_INTERFACE, FLAG_RECOIL, FLAG_SOLIDIFICATION,
-    FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT, LASER_SURFACE,
+    FLAG_SURFACE_TENSION, FLAG_WETTING, HEAT_TRAPEZOIDAL, LASER_BEER_LAMBERT, LASER_RAY_TRACED,
+    LASER_SURFACE,
 };
 use crate::state::State;
 
@@ -113,6 +114,8 @@ pub struct Features {
     pub laser_bins: bool,
     /// Gaussian surface-flux laser.
     pub laser_surface: bool,
+    /// Ray-traced laser (bins, rays, deposit).
+    pub laser_rays: bool,
     /// F22 (24)–(26) surface tension.
     pub surface_tension: bool,
     /// Its free-surface form (R18): the curvature is smoothed in a second dispatch.
@@ -151,6 +154,7 @@ impl Features {
             gas_interface: params.flag(FLAG_GAS_INTERFACE),
             laser_bins: params.laser.model == LASER_BEER_LAMBERT,
             laser_surface: params.laser.model == LASER_SURFACE,
+            laser_rays: params.laser.model == LASER_RAY_TRACED,
             surface_tension: params.flag(FLAG_SURFACE_TENSION),
             free_surface_tension: params.flag(FLAG_FREE_SURFACE_TENSION),
             colour_tension: params.flag(FLAG_COLOUR_TENSION),
@@ -181,6 +185,8 @@ pub enum Work {
     LaserBins,
     /// One thread per laser column.
     LaserColumns,
+    /// One thread per ray of the ray-traced laser.
+    LaserRays,
     /// One workgroup per `REDUCE_WG` particles.
     Reduction,
     /// A single workgroup.
@@ -543,7 +549,7 @@ pub const STAGES: [StageDef; 33] = [
         stage: Stage::Laser,
         name: "laser",
         file: "laser",
-        needed: |f| f.laser_bins || f.laser_surface,
+        needed: |f| f.laser_bins || f.laser_surface || f.laser_rays,
         dispatches: &[
             when(
                 "laser_surface",
@@ -554,7 +560,7 @@ pub const STAGES: [StageDef; 33] = [
             when(
                 "laser_bins",
                 Work::LaserBins,
-                |f| f.laser_bins,
+                |f| f.laser_bins || f.laser_rays,
                 |b| b.laser_bins(),
             ),
             when(
@@ -564,9 +570,21 @@ pub const STAGES: [StageDef; 33] = [
                 |b| b.laser_columns(),
             ),
             when(
+                "laser_rays",
+                Work::LaserRays,
+                |f| f.laser_rays,
+                |b| b.laser_rays(),
+            ),
+            when(
+                "laser_ray_bins",
+                Work::LaserBins,
+                |f| f.laser_rays,
+                |b| b.laser_ray_bins(),
+            ),
+            when(
                 "laser_deposit",
                 Work::Particles,
-                |f| f.laser_bins,
+                |f| f.laser_bins || f.laser_rays,
                 |b| b.laser_deposit(),
             ),
         ],

@@ -76,6 +76,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     ),
     (scene_file!("validation/laplace_sphere_3d"), &["dx=4e-3"]),
     (scene_file!("validation/laser_flat_plate"), &["dx=2e-5"]),
+    (scene_file!("validation/laser_ray_plate"), &["dx=1e-5"]),
     (
         scene_file!("validation/laser_plate_under_gas_2d"),
         &["dx=2e-5"],
@@ -113,6 +114,9 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=0.025"],
     ),
     (scene_file!("pbf/line_melt_bare_plate"), &["dx=2e-5"]),
+    (scene_file!("pbf/amb2018_02_a"), &["dx=2e-5"]),
+    (scene_file!("pbf/amb2018_02_b"), &["dx=2e-5"]),
+    (scene_file!("pbf/amb2018_02_c"), &["dx=2e-5"]),
     (scene_file!("pbf/line_melt_coarse_2d"), &[]),
     (scene_file!("pbf/r18_track_2d"), &[]),
     (

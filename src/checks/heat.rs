@@ -241,7 +241,9 @@ pub fn laser_energy(
         .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
         .sum();
     let delivered_by = |l: Option<&crate::model::Laser>| {
-        l.map_or(0.0, |l| l.absorptivity * l.energy_until(st.sim.time as f64))
+        l.map_or(0.0, |l| {
+            l.absorptivity.unwrap_or(f64::NAN) * l.energy_until(st.sim.time as f64)
+        })
     };
     // Each step applies the power at its start time: the integral below matches
     // that exactly while the power is constant, and to one step's energy
@@ -330,7 +332,7 @@ pub fn rosenthal(m: &Model, st: &State) -> (String, f64, Vec<String>) {
     let (t1, p1) = l.path[n - 1];
     let v = (p1[0] - p0[0]) / (t1 - t0);
     let beam = l.centre_at(t);
-    let q = l.absorptivity * l.power_at(t);
+    let q = l.absorptivity.unwrap_or(f64::NAN) * l.power_at(t);
     let up = m.dim as usize - 1;
     let top = m.domain_hi[up];
     let pts: Vec<(f64, f64, f64, f64, usize)> = (0..st.len())

@@ -14,7 +14,8 @@
 //! drop's remelt of its substrate), drops.rs (F22 §4.3: drops on drops),
 //! point_melt.rs (F22 §4.5: PBF point melting's keyhole, ejections,
 //! indentation), deposition.rs (F22 §4.4: grains flying into a laser pool),
-//! binder.rs (F22 §4.2: a binder drop into a powder bed).
+//! binder.rs (F22 §4.2: a binder drop into a powder bed), measured_track.rs (a
+//! laser track's melt pool against a measured one: NIST AM-Bench AMB2018-02).
 
 mod binder;
 mod bodies;
@@ -26,6 +27,7 @@ mod expansion;
 mod flow;
 mod heat;
 mod impact;
+mod measured_track;
 mod noise;
 mod point_melt;
 mod remelt;
@@ -236,6 +238,7 @@ fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
         CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),
         CheckKind::Deposition => Box::new(deposition::Deposition::new(c)),
         CheckKind::Binder => Box::new(binder::Binder::new(c)),
+        CheckKind::MeasuredTrack => Box::new(measured_track::MeasuredTrack::new(c)),
         CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
             c.energy_tolerance.unwrap_or(f64::NAN),
         )),

@@ -18,8 +18,17 @@ pub struct HeatDiagnostics {
     pub max_temperature: f64,
     /// J (per metre of depth in 2D), Σ m h over conducting particles.
     pub total_enthalpy: f64,
-    /// ζ P(t) of the laser (W; W/m in 2D); 0 without a laser.
+    /// Laser power absorbed in the last step (W; W/m in 2D): ζ P(t), or the
+    /// ray-traced bundle's absorbed sum; 0 without a laser.
     pub absorbed_laser_power: f64,
+    /// The beam power of the last step (the bundle's launched sum).
+    pub incident_laser_power: f64,
+    /// Beam power not absorbed: rays that left the domain, or (1 − ζ) P.
+    pub leaving_laser_power: f64,
+    /// absorbed / incident (0 with the beam off).
+    pub laser_absorbed_fraction: f64,
+    /// Of the absorbed power, what rays still carried at their bounce limit.
+    pub bounce_limit_laser_power: f64,
     /// Σ f_l V over liquid and solid particles (m³; m² in 2D).
     pub melted_volume: f64,
     pub pool_depth: f64,
@@ -36,6 +45,56 @@ pub struct HeatDiagnostics {
     pub evaporated_power: f64,
     /// Heat leaving through free surfaces by radiation (W; W/m in 2D).
     pub radiated_power: f64,
+}
+
+/// The laser's power split in the state's last step (W; W/m in 2D).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaserBalance {
+    pub incident: f64,
+    pub absorbed: f64,
+    pub leaving: f64,
+    /// Of `absorbed`, what rays carried at their bounce limit (ray-traced).
+    pub at_limit: f64,
+}
+
+impl LaserBalance {
+    /// From the ray counts the device wrote (ray-traced), or ζ P(t) at the
+    /// state's time; None without a laser.
+    pub fn of(m: &Model, st: &State) -> Option<LaserBalance> {
+        use crate::state::{RAYS_ABSORBED, RAYS_AT_LIMIT, RAYS_INCIDENT, RAYS_LEAVING};
+        let l = m.laser.as_ref()?;
+        match l.absorptivity {
+            Some(z) => {
+                let p = l.power_at(st.sim.time as f64);
+                Some(LaserBalance {
+                    incident: p,
+                    absorbed: z * p,
+                    leaving: (1.0 - z) * p,
+                    at_limit: 0.0,
+                })
+            }
+            None => {
+                let c = &st.laser_rays;
+                if c.len() < 4 {
+                    return None;
+                }
+                let unit = crate::params::ray_power_unit(l) as f64;
+                Some(LaserBalance {
+                    incident: c[RAYS_INCIDENT] as f64 * unit,
+                    absorbed: c[RAYS_ABSORBED] as f64 * unit,
+                    leaving: c[RAYS_LEAVING] as f64 * unit,
+                    at_limit: c[RAYS_AT_LIMIT] as f64 * unit,
+                })
+            }
+        }
+    }
+    pub fn fraction(&self) -> f64 {
+        if self.incident > 0.0 {
+            self.absorbed / self.incident
+        } else {
+            0.0
+        }
+    }
 }
 
 /// (evaporated, radiated) power through free surfaces, host-side in f64 from the
@@ -70,10 +129,11 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
     let mut d = HeatDiagnostics {
         max_temperature: f64::NEG_INFINITY,
         total_enthalpy: 0.0,
-        absorbed_laser_power: m
-            .laser
-            .as_ref()
-            .map_or(0.0, |l| l.absorptivity * l.power_at(st.sim.time as f64)),
+        absorbed_laser_power: 0.0,
+        incident_laser_power: 0.0,
+        leaving_laser_power: 0.0,
+        laser_absorbed_fraction: 0.0,
+        bounce_limit_laser_power: 0.0,
         melted_volume: 0.0,
         pool_depth: 0.0,
         pool_width: 0.0,
@@ -85,6 +145,13 @@ pub fn heat_diagnostics(m: &Model, st: &State) -> Option<HeatDiagnostics> {
         evaporated_power: 0.0,
         radiated_power: 0.0,
     };
+    if let Some(b) = LaserBalance::of(m, st) {
+        d.incident_laser_power = b.incident;
+        d.absorbed_laser_power = b.absorbed;
+        d.leaving_laser_power = b.leaving;
+        d.bounce_limit_laser_power = b.at_limit;
+        d.laser_absorbed_fraction = b.fraction();
+    }
     (d.evaporated_power, d.radiated_power) = surface_loss_power(m, st);
     for i in 0..st.active() {
         let ph = &m.phases[st.phase[i] as usize];

@@ -10,7 +10,7 @@ mod leakage;
 mod schema;
 mod surface;
 
-pub use heat::{heat_diagnostics, set_pool, surface_loss_power, HeatDiagnostics};
+pub use heat::{heat_diagnostics, set_pool, surface_loss_power, HeatDiagnostics, LaserBalance};
 pub use leakage::Leakage;
 pub use schema::{bodies_schema, check_schema, diagnostics_schema, removal_schema, track_schema};
 pub use surface::{surface_diagnostics, SurfaceDiagnostics, INTERIOR_SHEPARD};

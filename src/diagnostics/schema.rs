@@ -90,7 +90,23 @@ pub fn diagnostics_schema(m: &Model) -> serde_json::Value {
             ),
             (
                 "absorbed_laser_power",
-                format!("absorptivity x beam power, W{unit}"),
+                format!("laser power absorbed in the last step: absorptivity x beam power, or the ray-traced rays' absorbed sum, W{unit}"),
+            ),
+            (
+                "incident_laser_power",
+                format!("beam power in the last step (the ray-traced bundle's launched sum), W{unit}"),
+            ),
+            (
+                "leaving_laser_power",
+                format!("laser power not absorbed: reflected out of the domain (ray-traced), or (1 - absorptivity) x beam power, W{unit}"),
+            ),
+            (
+                "laser_absorbed_fraction",
+                "absorbed / incident laser power (the figure calorimetry measures; 0 with the beam off)".into(),
+            ),
+            (
+                "bounce_limit_laser_power",
+                format!("part of the absorbed power that rays still carried at laser.max_bounces, taken up at their last hit, W{unit}"),
             ),
             (
                 "melted_volume",

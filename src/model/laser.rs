@@ -5,12 +5,76 @@ use super::*;
 /// Most path points and power steps the parameter block holds.
 pub const MAX_LASER_POINTS: usize = 8;
 
+/// Default rays per Δx across the beam (ray-traced model).
+pub const DEFAULT_RAYS_PER_DX: u32 = 2;
+/// Default surface hits per ray (ray-traced model).
+pub const DEFAULT_MAX_BOUNCES: u32 = 8;
+/// The ray bundle reaches out to this many beam radii r_w (a Gaussian beam
+/// carries exp(−8) = 3.4e-4 of its power beyond 2 r_w; the bundle's weights are
+/// normalised to the whole power).
+pub const RAY_EXTENT_RADII: f64 = 2.0;
+/// Vacuum permittivity ε0 (F/m) and the speed of light c (m/s), for Hagen–Rubens.
+const EPSILON_0: f64 = 8.854_187_812_8e-12;
+const LIGHT_SPEED: f64 = 2.997_924_58e8;
+
+/// The ray-traced model's bundle and the materials' optics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RayTracing {
+    pub profile: crate::scene::BeamProfile,
+    pub rays_per_dx: u32,
+    pub max_bounces: u32,
+    /// Complex refractive index (n, k) of each phase at the laser's wavelength,
+    /// None where the phase does not absorb (walls, gas).
+    pub optics: Vec<Option<(f64, f64)>>,
+}
+
+impl RayTracing {
+    /// Rays per lateral axis: an odd count centred on the beam, spacing
+    /// Δx / rays_per_dx, out to RAY_EXTENT_RADII r_w (a top hat: its radius).
+    pub fn rays_per_side(&self, dx: f64, radius: f64) -> u32 {
+        let spacing = dx / self.rays_per_dx as f64;
+        let reach = match self.profile {
+            crate::scene::BeamProfile::Gaussian => RAY_EXTENT_RADII * radius,
+            crate::scene::BeamProfile::TopHat => radius,
+        };
+        2 * (reach / spacing).ceil() as u32 + 1
+    }
+}
+
+/// Fresnel absorptivity 1 − (R_s + R_p)/2 of a surface of complex index n + ik
+/// for unpolarised light at incidence cosine `cos` (Born & Wolf §14.2; the
+/// real form of Bass, Handbook of Optics vol. I ch. 12). At normal incidence
+/// 4n / ((n + 1)² + k²).
+pub fn fresnel_absorptivity(n: f64, k: f64, cos: f64) -> f64 {
+    let c = cos.clamp(1e-6, 1.0);
+    let s2 = 1.0 - c * c;
+    let a_ = n * n - k * k - s2;
+    let b_ = (a_ * a_ + 4.0 * n * n * k * k).sqrt();
+    let a = (0.5 * (b_ + a_)).sqrt();
+    let b2 = 0.5 * (b_ - a_);
+    let rs = ((a - c).powi(2) + b2) / ((a + c).powi(2) + b2);
+    let st = s2 / c;
+    let rp = rs * ((a - st).powi(2) + b2) / ((a + st).powi(2) + b2);
+    1.0 - 0.5 * (rs + rp)
+}
+
+/// Hagen–Rubens: n = k = 1/√(2 ε0 ω ρ_e) for a metal of DC resistivity ρ_e
+/// (Ω m) at vacuum wavelength λ (m), ω = 2π c/λ.
+pub fn hagen_rubens_index(resistivity: f64, wavelength: f64) -> f64 {
+    let omega = 2.0 * std::f64::consts::PI * LIGHT_SPEED / wavelength;
+    1.0 / (2.0 * EPSILON_0 * omega * resistivity).sqrt()
+}
+
 /// A validated laser source (issue 4). Lateral coordinates are absolute.
 #[derive(Debug, Clone)]
 pub struct Laser {
     pub model: crate::scene::LaserModel,
-    pub absorptivity: f64,
+    /// ζ of the Beer–Lambert and surface models; None for the ray-traced one,
+    /// whose absorbed fraction follows from the surface it meets.
+    pub absorptivity: Option<f64>,
     pub radius: f64,
+    /// The ray-traced model's bundle and optics.
+    pub rays: Option<RayTracing>,
     pub absorption: f64,
     /// (time, power) steps.
     pub power: Vec<(f64, f64)>,
@@ -74,23 +138,67 @@ pub(super) fn laser_source(
             "a laser needs a heat scene (phases with a temperature)",
         ));
     }
-    let absorptivity = cx.positive("laser.absorptivity", l.absorptivity)?;
-    if absorptivity > 1.0 {
-        return Err(cx.err(
-            "laser.absorptivity",
-            format!("must lie in (0, 1] (got {absorptivity})"),
-        ));
-    }
+    use crate::scene::LaserModel;
+    let traced = l.model == LaserModel::RayTraced;
+    let absorptivity = match (l.absorptivity, traced) {
+        (Some(_), true) => {
+            return Err(cx.err(
+                "laser.absorptivity",
+                "the ray_traced model takes the absorbed fraction from the materials' \
+                 optical constants (refractive_index or electrical_resistivity); remove it",
+            ))
+        }
+        (None, true) => None,
+        (None, false) => {
+            return Err(cx.err(
+                "laser.absorptivity",
+                "missing: the beer_lambert and gaussian_surface models need ζ in (0, 1]",
+            ))
+        }
+        (Some(z), false) => {
+            let z = cx.positive("laser.absorptivity", z)?;
+            if z > 1.0 {
+                return Err(cx.err(
+                    "laser.absorptivity",
+                    format!("must lie in (0, 1] (got {z})"),
+                ));
+            }
+            Some(z)
+        }
+    };
     let radius = cx.positive("laser.radius", l.radius)?;
     let absorption = match (l.model, l.absorption_coefficient) {
+        (LaserModel::RayTraced, Some(_)) => {
+            return Err(cx.err(
+                "laser.absorption_coefficient",
+                "not used by the ray_traced model (rays are absorbed at the surface)",
+            ))
+        }
         (_, Some(a)) => cx.positive("laser.absorption_coefficient", a)?,
-        (crate::scene::LaserModel::BeerLambert, None) => {
+        (LaserModel::BeerLambert, None) => {
             return Err(cx.err(
                 "laser.absorption_coefficient",
                 "missing: the beer_lambert model needs it (1/m)",
             ))
         }
-        (crate::scene::LaserModel::GaussianSurface, None) => 0.0,
+        (_, None) => 0.0,
+    };
+    let rays = if traced {
+        Some(ray_tracing(cx, scene, phases)?)
+    } else {
+        for (key, given) in [
+            (
+                "laser.profile",
+                l.profile != crate::scene::BeamProfile::Gaussian,
+            ),
+            ("laser.rays_per_dx", l.rays_per_dx.is_some()),
+            ("laser.max_bounces", l.max_bounces.is_some()),
+        ] {
+            if given {
+                return Err(cx.err(key, "only the ray_traced model uses it"));
+            }
+        }
+        None
     };
     let points =
         |key: &str, list: &Vec<Vec<f64>>, width: usize| -> Result<Vec<Vec<f64>>, InputError> {
@@ -141,10 +249,97 @@ pub(super) fn laser_source(
         model: l.model,
         absorptivity,
         radius,
+        rays,
         absorption,
         power,
         path,
     }))
+}
+
+/// The ray-traced model's keys and every absorbing phase's optical constants.
+fn ray_tracing(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &[PhaseInfo],
+) -> Result<RayTracing, InputError> {
+    let l = scene.laser.as_ref().expect("a laser section");
+    let rays_per_dx = l.rays_per_dx.unwrap_or(DEFAULT_RAYS_PER_DX);
+    if !(1..=8).contains(&rays_per_dx) {
+        return Err(cx.err(
+            "laser.rays_per_dx",
+            format!("must be 1 to 8 (got {rays_per_dx})"),
+        ));
+    }
+    let max_bounces = l.max_bounces.unwrap_or(DEFAULT_MAX_BOUNCES);
+    if !(1..=64).contains(&max_bounces) {
+        return Err(cx.err(
+            "laser.max_bounces",
+            format!("must be 1 to 64 (got {max_bounces})"),
+        ));
+    }
+    let wavelength = match l.wavelength {
+        Some(w) => Some(cx.positive("laser.wavelength", w)?),
+        None => None,
+    };
+    let mut optics = Vec::with_capacity(phases.len());
+    for p in phases {
+        if !p.conducts() || p.kind == crate::scene::PhaseKind::Gas {
+            optics.push(None);
+            continue;
+        }
+        let mat = &scene.materials[&p.material];
+        let key = |k: &str| format!("materials.{}.{k}", p.material);
+        let nk = match (&mat.refractive_index, mat.electrical_resistivity) {
+            (Some(_), Some(_)) => {
+                return Err(cx.err(
+                    &key("electrical_resistivity"),
+                    "give refractive_index or electrical_resistivity, not both",
+                ))
+            }
+            (Some(v), None) => {
+                if v.len() != 2 || !v.iter().all(|x| x.is_finite() && *x >= 0.0) || v[0] <= 0.0 {
+                    return Err(cx.err(
+                        &key("refractive_index"),
+                        "expected [n, k] with n > 0 and k >= 0",
+                    ));
+                }
+                (v[0], v[1])
+            }
+            (None, Some(r)) => {
+                let r = cx.positive(&key("electrical_resistivity"), r)?;
+                let Some(w) = wavelength else {
+                    return Err(cx.err(
+                        "laser.wavelength",
+                        format!(
+                            "missing: materials.{}.electrical_resistivity needs the \
+                             laser's wavelength (m) for Hagen–Rubens",
+                            p.material
+                        ),
+                    ));
+                };
+                let n = hagen_rubens_index(r, w);
+                (n, n)
+            }
+            (None, None) => {
+                return Err(cx.err(
+                    &key("refractive_index"),
+                    format!(
+                        "missing: phase '{}' absorbs the ray-traced laser; give its \
+                         material's refractive_index [n, k] at the laser's wavelength \
+                         or its electrical_resistivity",
+                        p.name
+                    ),
+                ))
+            }
+        };
+        optics.push(Some(nk));
+    }
+    Ok(RayTracing {
+        profile: l.profile,
+        rays_per_dx,
+        max_bounces,
+        optics,
+    })
 }
 
 /// The schedule with the beam off from t_off on: steps at or after t_off are
@@ -168,7 +363,43 @@ fn switch_off(mut power: Vec<(f64, f64)>, t_off: f64) -> Result<Vec<(f64, f64)>,
 
 #[cfg(test)]
 mod tests {
-    use super::switch_off;
+    use super::{fresnel_absorptivity, hagen_rubens_index, switch_off};
+
+    #[test]
+    fn fresnel_absorptivity_at_normal_incidence_and_grazing() {
+        // 4n / ((n + 1)² + k²) at normal incidence, for a metal and a dielectric
+        for (n, k) in [(2.6, 5.2), (4.96, 4.96), (1.5, 0.0)] {
+            let exact = 4.0 * n / ((n + 1.0) * (n + 1.0) + k * k);
+            assert!((fresnel_absorptivity(n, k, 1.0) - exact).abs() < 1e-12);
+        }
+        // a metal absorbs more p-light towards grazing: the unpolarised mean
+        // rises to a maximum near the principal angle, then falls to 0 at 90°
+        let a = |deg: f64| fresnel_absorptivity(2.6, 5.2, deg.to_radians().cos());
+        assert!(a(60.0) > a(0.0) && a(80.0) > a(60.0));
+        assert!(a(89.999) < 0.01);
+        // glass: R_s = R_p = 0.04 at normal incidence, Brewster's angle
+        // tan θ_B = n gives R_p = 0, so A = 1 − R_s/2 there
+        let tb = 1.5f64.atan();
+        let rs = ((tb.cos() - 1.5 * (1.0 - (tb.sin() / 1.5).powi(2)).sqrt())
+            / (tb.cos() + 1.5 * (1.0 - (tb.sin() / 1.5).powi(2)).sqrt()))
+        .powi(2);
+        assert!((fresnel_absorptivity(1.5, 0.0, tb.cos()) - (1.0 - 0.5 * rs)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hagen_rubens_gives_the_metals_normal_absorptivity() {
+        // IN625's 1.29 µΩ m at 1.07 µm: n = k ≈ 5.0, A ≈ 0.33
+        let n = hagen_rubens_index(1.29e-6, 1.07e-6);
+        assert!((n - 5.0).abs() < 0.1, "{n}");
+        // Bramson's series for the same metal (ρ_e in Ω cm, λ in cm; Bramson
+        // 1968, "Infrared radiation: a handbook for applications"):
+        // A = 0.365 √(ρ/λ) − 0.0667 (ρ/λ) + 0.006 (ρ/λ)^1.5, which is the
+        // expansion of 4n/((n + 1)² + n²) in 1/n
+        let a = fresnel_absorptivity(n, n, 1.0);
+        let x: f64 = 1.29e-4 / 1.07e-4;
+        let bramson = 0.365 * x.sqrt() - 0.0667 * x + 0.006 * x.powf(1.5);
+        assert!((a - bramson).abs() < 0.01 * bramson, "{a} {bramson}");
+    }
 
     #[test]
     fn power_until_ends_any_schedule_with_the_beam_off() {

@@ -10,7 +10,7 @@ mod phases;
 mod tension;
 mod thermal;
 
-pub use laser::{Laser, MAX_LASER_POINTS};
+pub use laser::{fresnel_absorptivity, hagen_rubens_index, Laser, RayTracing, MAX_LASER_POINTS};
 pub use phases::{Evaporation, PhaseInfo, TemperatureWave, Thermal};
 pub use tension::SurfaceTension;
 
@@ -505,7 +505,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         .filter(|_| !implicit_viscosity)
         .map(|p| p.viscosity / p.rho0)
         .fold(
-            interface_viscosity_nu(&cx, sim, &fluid, dim, h)?
+            interface_viscosity_nu(&cx, sim, &fluid, dim, h, dx)?
                 + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
             f64::max,
         );
@@ -669,6 +669,20 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
         {
             use crate::scene::CheckKind as K;
+            let traced = scene
+                .laser
+                .as_ref()
+                .is_some_and(|l| l.model == crate::scene::LaserModel::RayTraced);
+            if traced && matches!(c.kind, K::Rosenthal | K::LaserEnergy) {
+                return Err(cx.err(
+                    "check.kind",
+                    format!(
+                        "\"{}\" compares with a fixed absorptivity ζ: not with \
+                         laser.model = \"ray_traced\"",
+                        c.kind.name()
+                    ),
+                ));
+            }
             let constant_reference = matches!(
                 c.kind,
                 K::Conduction1d
@@ -749,6 +763,16 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         if c.kind == crate::scene::CheckKind::Binder {
             binder_needs(&cx, scene, c)?;
         }
+        if c.kind == crate::scene::CheckKind::MeasuredTrack {
+            match (&c.measured, &scene.laser) {
+                (Some(d), Some(_)) => d.validate(file, dim)?,
+                (None, _) => return Err(cx.err(
+                    "check.measured",
+                    "missing: measured_track needs [check.measured] (width, depth, length, steady)",
+                )),
+                (_, None) => return Err(cx.err("check.kind", "\"measured_track\" needs a [laser]")),
+            }
+        }
         if c.kind == crate::scene::CheckKind::Laplace {
             cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
             cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
@@ -761,6 +785,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
     }
     if let Some(w) = dispersion_risk(file, sim, &phases, surface_tension.as_ref()) {
+        warnings.push(w);
+    }
+    if let Some(w) = recoil_risk(file, &phases) {
         warnings.push(w);
     }
     if let Some(w) = breakup_risk(file, sim, &phases, surface_tension.as_ref(), (dim, dx, h)) {
@@ -866,7 +893,7 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
             .positive("simulation.ambient_temperature", sim.ambient_temperature)?,
         pressure_floor: sim.pressure_floor,
         hydrostatic_axis,
-        interface_viscosity: sim.interface_viscosity,
+        interface_viscosity: sim.interface_viscosity.alpha(dx),
         solid_fluid_viscosity: solid_fluid,
         jitter: sim.jitter,
         seed: sim.seed,
@@ -986,13 +1013,45 @@ fn dispersion_risk(
 ) -> Option<String> {
     let t = tension?;
     let ratio = phases[t.liquid].rho0 / phases[t.gas?].rho0;
-    (ratio >= 10.0 && sim.interface_viscosity == 0.0).then(|| {
+    (ratio >= 10.0 && matches!(sim.interface_viscosity, crate::scene::InterfaceViscosityDef::Alpha(a) if a == 0.0)).then(|| {
         format!(
             "{file}: key `simulation.interface_viscosity`: surface tension with gas at a density \
              ratio of {ratio:.0} and no liquid-gas interface viscosity: the liquid can disperse \
              into its gas (the watchdog stops such a run, watchdog.on_dispersion); F22 uses \
              7.2 for molten steel (Table 1) and 1.8 for a liquid binder (Table 4)"
         )
+    })
+}
+
+/// The share of ρ0 c² the recoil pressure may reach at the boiling point: the
+/// F22 (30) law p_r = C_p exp(−C_T (1/T − 1/T_v)) is C_p there and grows e-fold
+/// every T_v²/C_T (about 200 K for metals) above it, and the weakly compressible
+/// melt gives way by p/(ρ0 c²): at 1% at T_v it is 5-15% a few hundred kelvin
+/// above, where the melt under a beam goes (a sound speed of 5 m/s took a 3D
+/// bare-plate melt through its floor).
+const RECOIL_SHARE_AT_BOILING: f64 = 0.01;
+
+/// A warning for a liquid with the recoil whose sound speed is too low for it.
+fn recoil_risk(file: &str, phases: &[PhaseInfo]) -> Option<String> {
+    phases.iter().find_map(|p| {
+        let e = p.recoil()?;
+        let stiffness = p.rho0 * p.sound_speed * p.sound_speed;
+        let share = e.pressure_constant / stiffness;
+        let e_fold = e.boiling_temperature * e.boiling_temperature / e.temperature_constant;
+        (share > RECOIL_SHARE_AT_BOILING).then(|| {
+            format!(
+                "{file}: key `materials.{}.sound_speed` (or `reference_pressure`): the recoil pressure at the boiling point \
+                 ({:.3e} Pa, rising e-fold every {e_fold:.0} K above it) is {:.1}% of rho0 c^2 = \
+                 {stiffness:.3e} Pa on phase `{}`: the melt under the beam compresses by as much; \
+                 keep it below {:.0}% (a sound speed of at least {:.1} m/s)",
+                p.material,
+                e.pressure_constant,
+                100.0 * share,
+                p.name,
+                100.0 * RECOIL_SHARE_AT_BOILING,
+                (e.pressure_constant / (RECOIL_SHARE_AT_BOILING * p.rho0)).sqrt()
+            )
+        })
     })
 }
 
@@ -1021,7 +1080,7 @@ fn breakup_risk(
         return None;
     }
     let liquid = &phases[t.liquid];
-    let nu_art = artificial_nu(sim.interface_viscosity, &[liquid], dim, h);
+    let nu_art = artificial_nu(sim.interface_viscosity.alpha(dx), &[liquid], dim, h);
     let mu = liquid.viscosity + liquid.rho0 * nu_art;
     let oh = mu / (liquid.rho0 * t.max_coefficient(phases) * dx).sqrt();
     (oh < BREAKUP_OHNESORGE).then(|| {

@@ -367,9 +367,10 @@ pub(super) fn interface_viscosity_nu(
     fluid: &[&PhaseInfo],
     dim: u32,
     h: f64,
+    dx: f64,
 ) -> Result<f64, InputError> {
     let key = "simulation.interface_viscosity";
-    let alpha = cx.non_negative(key, sim.interface_viscosity)?;
+    let alpha = cx.non_negative(key, sim.interface_viscosity.alpha(dx))?;
     if alpha == 0.0 {
         return Ok(0.0);
     }

@@ -14,7 +14,7 @@ mod forces_avx2;
 mod heat;
 mod integrate;
 mod interface;
-mod laser;
+pub mod laser;
 mod neighbors;
 mod recorded;
 mod reduce;
@@ -43,8 +43,10 @@ pub struct CpuBackend {
     pairs: dfsph_pairs::PairTable,
     /// The velocity system's pair coefficients, from its `begin` (for `apply`).
     couplings: dfsph_viscosity::Couplings,
-    /// Laser bins: (Σ wV, absorbed power), laser scenes only.
-    laser_bins: Vec<[f32; 2]>,
+    /// Laser bins: (Σ wV, absorbed power, Σ wV n, Σ wV k), laser scenes only.
+    laser_bins: Vec<[f32; 4]>,
+    /// Ray-traced laser: each bin's absorbed power in fixed-point counts.
+    ray_counts: Vec<u32>,
     times: Vec<(&'static str, f64)>,
 }
 
@@ -60,6 +62,7 @@ impl CpuBackend {
             pairs: dfsph_pairs::PairTable::default(),
             couplings: dfsph_viscosity::Couplings::default(),
             laser_bins: Vec::new(),
+            ray_counts: Vec::new(),
             times: Vec::new(),
         }
     }
@@ -202,6 +205,19 @@ impl CpuBackend {
     }
     pub(crate) fn laser_columns(&mut self) {
         laser::columns(&self.params, self.st.sim.time, &mut self.laser_bins)
+    }
+    pub(crate) fn laser_rays(&mut self) {
+        let t = self.st.sim.time;
+        laser::rays(
+            &self.params,
+            t,
+            &self.laser_bins,
+            &mut self.ray_counts,
+            &mut self.st.laser_rays,
+        )
+    }
+    pub(crate) fn laser_ray_bins(&mut self) {
+        laser::ray_bins(&self.params, &self.ray_counts, &mut self.laser_bins)
     }
     pub(crate) fn laser_deposit(&mut self) {
         laser::deposit(&self.params, &mut self.st, &self.laser_bins)

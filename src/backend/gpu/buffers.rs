@@ -10,7 +10,7 @@
 
 use super::sort::{stage_uniforms, SortStep};
 use crate::fields::{Held, FIELDS, TABLES};
-use crate::params::{Params, LASER_BEER_LAMBERT};
+use crate::params::{Params, LASER_BEER_LAMBERT, LASER_RAY_TRACED};
 use crate::state::{Sim, State};
 use wgpu::util::DeviceExt;
 
@@ -24,7 +24,7 @@ pub struct DeviceBuffer {
 }
 
 /// The device-only buffers, in binding order after the fields and tables.
-pub const DEVICE_BUFFERS: [DeviceBuffer; 8] = [
+pub const DEVICE_BUFFERS: [DeviceBuffer; 9] = [
     // Neighbour search: sort keys (cell, index), the cell table.
     DeviceBuffer {
         name: "keys",
@@ -55,10 +55,16 @@ pub const DEVICE_BUFFERS: [DeviceBuffer; 8] = [
         name: "partials",
         wgsl: "array<vec2<f32>>",
     },
-    // Laser scenes: per bin (Σ w V, absorbed power).
+    // Laser scenes: per bin (Σ w V, absorbed power, Σ w V n, Σ w V k).
     DeviceBuffer {
         name: "bins",
-        wgsl: "array<vec2<f32>>",
+        wgsl: "array<vec4<f32>>",
+    },
+    // Ray-traced laser: per bin, the absorbed power in fixed-point counts
+    // (order-free integer atomics).
+    DeviceBuffer {
+        name: "ray_counts",
+        wgsl: "array<atomic<u32>>",
     },
     // Rigid bodies: each particle id's current index (body_slots).
     DeviceBuffer {
@@ -173,8 +179,11 @@ pub struct Buffers {
     pub sim: wgpu::Buffer,
     pub partials: wgpu::Buffer,
     pub sort_stages: wgpu::Buffer,
-    /// Laser bins (Σ wV, absorbed power); a 16-byte placeholder without a laser.
+    /// Laser bins (Σ wV, absorbed power, Σ wV n, Σ wV k); a 16-byte
+    /// placeholder without a laser.
     pub bins: wgpu::Buffer,
+    /// Ray-traced laser: each bin's absorbed count; a placeholder otherwise.
+    pub ray_counts: wgpu::Buffer,
     /// One per `TABLES` row (a placeholder of `min_entries` where the scene lacks it).
     pub tables: Vec<wgpu::Buffer>,
     /// Rigid bodies: each id's current index (a placeholder without bodies).
@@ -183,7 +192,7 @@ pub struct Buffers {
 
 /// Laser bins in the scene (0 without a laser).
 pub fn laser_bin_count(p: &Params) -> u32 {
-    if p.laser.model != LASER_BEER_LAMBERT {
+    if p.laser.model != LASER_BEER_LAMBERT && p.laser.model != LASER_RAY_TRACED {
         return 0;
     }
     p.laser.bins[0] * p.laser.bins[1] * p.laser.bins[2]
@@ -248,7 +257,16 @@ impl Buffers {
                 contents: &stage_uniforms(sort),
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
-            bins: storage(device, "laser bins", laser_bin_count(params) as u64 * 8),
+            bins: storage(device, "laser bins", laser_bin_count(params) as u64 * 16),
+            ray_counts: storage(
+                device,
+                "ray counts",
+                if params.laser.model == LASER_RAY_TRACED {
+                    laser_bin_count(params) as u64 * 4
+                } else {
+                    0
+                },
+            ),
             tables: TABLES
                 .iter()
                 .map(|t| {
@@ -284,6 +302,7 @@ impl Buffers {
             "sim" => &self.sim,
             "partials" => &self.partials,
             "bins" => &self.bins,
+            "ray_counts" => &self.ray_counts,
             "slots" => &self.slots,
             other => panic!("no buffer for binding {other}"),
         }

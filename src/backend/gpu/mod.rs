@@ -136,6 +136,11 @@ impl GpuBackend {
                 let cols = if p.sizes.dim == 3 { b[0] * b[1] } else { b[0] };
                 cols.div_ceil(WG)
             }
+            Work::LaserRays => {
+                let r = p.laser.rays_per_side;
+                let rays = if p.sizes.dim == 3 { r * r } else { r };
+                rays.div_ceil(WG)
+            }
             Work::Reduction => self.n.div_ceil(REDUCE_WG),
             Work::Single => 1,
             Work::Bodies => p.bodies.n_bodies.div_ceil(WG),

@@ -438,7 +438,7 @@ impl InterfaceViscosityDef {
     pub fn alpha(&self, dx: f64) -> f64 {
         match *self {
             InterfaceViscosityDef::Alpha(a) => a,
-            InterfaceViscosityDef::Scaled { alpha, at_dx } if at_dx > 0.0 => alpha * at_dx / dx,
+            InterfaceViscosityDef::Scaled { alpha, at_dx } if at_dx > 0.0 => alpha * (at_dx / dx),
             InterfaceViscosityDef::Scaled { .. } => f64::NAN,
         }
     }

@@ -78,6 +78,7 @@ fn assert_balance(s: &Split, power: f64) {
         "counts {:?}",
         s.counts
     );
+    assert!((s.absorbed + s.leaving - s.incident).abs() <= 1e-6 * power);
     assert!(
         (s.incident - power).abs() < 1e-6 * power,
         "incident {} against {power} (unit {})",

@@ -14,14 +14,20 @@ fn lcg(seed: &mut u64) -> f32 {
     (*seed >> 40) as f32 / (1u64 << 24) as f32
 }
 
-#[test]
-fn portable_math_bit_identical_on_software_adapter() {
+/// The software adapter and a parameter block holding only the shader constants.
+fn software_adapter() -> (GpuContext, Params) {
     std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
         .expect("a Vulkan adapter (the test command installs lavapipe)");
     assert!(ctx.is_software(), "bit-match needs the software adapter");
     let mut params = Params::zeroed();
     params.consts = SHADER_CONSTS;
+    (ctx, params)
+}
+
+#[test]
+fn portable_math_bit_identical_on_software_adapter() {
+    let (ctx, params) = software_adapter();
     let mut seed = 7u64;
     let n = 1 << 16;
     // exp over [-100, 100] (including both saturations), ln over 1e-37..1e38 and a
@@ -59,12 +65,7 @@ fn portable_math_bit_identical_on_software_adapter() {
 /// (n² − s²) − k²: lavapipe reassociates n² − k² − s².
 #[test]
 fn fresnel_bit_identical_on_software_adapter() {
-    std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
-    let ctx = GpuContext::open(AdapterChoice::AnyGpu, false)
-        .expect("a Vulkan adapter (the test command installs lavapipe)");
-    assert!(ctx.is_software(), "bit-match needs the software adapter");
-    let mut params = Params::zeroed();
-    params.consts = SHADER_CONSTS;
+    let (ctx, params) = software_adapter();
     let mut seed = 11u64;
     let n = 1 << 14;
     let ns: Vec<f32> = (0..n).map(|_| 0.1 + 6.0 * lcg(&mut seed)).collect();

@@ -374,7 +374,7 @@ fn temperature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
 }
 
-// The solidification record (issue 29; twin of record_crossing in
+// The solidification record (twin of record_crossing in
 // src/backend/cpu/heat.rs): a melting particle whose temperature falls through
 // the liquidus in this step (t_start >= T_l > t_new) records the crossing's
 // time (linear in T within the step), its position and the cooling rate

@@ -48,7 +48,7 @@ fn cell_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (i >= arrayLength(&keys)) { return; }
     if (i < P.sizes.n_particles) {
         // A fluid particle outside the keep box has left: its key, n_cells, sorts
-        // it after every cell and keeps it out of the cell table (issue 18). Walls
+        // it after every cell and keeps it out of the cell table. Walls
         // stay, wherever they stand (those of a closed side reach past the open
         // face above it), except the members of a rigid body that left, which
         // body_place stamped with the time it left (w > 0).

@@ -4,9 +4,10 @@
 //! shaders/bodies.wgsl.
 //!
 //! Mass properties F22 (35)–(36) with the per-particle inertia of a sphere (3D)
-//! or disc (2D) of the particle's volume (PAPERS-EXTRACT §2.1 flags the printed
-//! (36) as dimensionally wrong). The body frame is the principal frame, so the
-//! free rotation splits into three exact rotations (backend::cpu::bodies).
+//! or disc (2D) of the particle's volume (the printed (36), 0.4 m √(0.75/π) Δx,
+//! is dimensionally a mass times a length). The body frame is the principal
+//! frame, so the free rotation splits into three exact rotations
+//! (backend::cpu::bodies).
 
 use crate::model::Model;
 use crate::state::{Body, State, NO_BODY};
@@ -225,8 +226,8 @@ pub fn assemble(m: &Model, st: &mut State, body_of: &[u32]) {
 }
 
 /// Rigid powder grains ejected from the bed: (ejected, grains), a grain counting
-/// when its centre is more than its own diameter above the bed's initial top
-/// (issue 17 item 6). None without a rigid bed.
+/// when its centre is more than its own diameter above the bed's initial top.
+/// None without a rigid bed.
 pub fn ejected_grains(m: &Model, st: &State) -> Option<(usize, usize)> {
     let list = ejected_grain_list(m, st)?;
     Some((list.iter().filter(|&&e| e).count(), list.len()))
@@ -257,7 +258,7 @@ pub fn grain_rise(m: &Model, st: &State) -> Option<Vec<f64>> {
     Some(rise)
 }
 
-/// What became of the rigid bodies (issue 17 item 6): bonded into the
+/// What became of the rigid bodies: bonded into the
 /// substrate, left the domain through an open side, fully molten, partly
 /// molten, whole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -1,8 +1,9 @@
-//! CPU reference vs GPU path, field by field after every pass (DESIGN.md bit-match
-//! contract). On a software adapter any difference is a failure; on hardware the
-//! two are compared by tolerance: the largest relative difference per field after one
-//! free-running step, and per pass with each pass started from the CPU's state, so
-//! that a pass's own difference is not mixed with those of the passes before it.
+//! CPU reference vs GPU path, field by field after every pass (the bit-match
+//! contract, docs/backends.md). On a software adapter any difference is a
+//! failure; on hardware the two are compared by tolerance: the largest relative
+//! difference per field after one free-running step, and per pass with each
+//! pass started from the CPU's state, so that a pass's own difference is not
+//! mixed with those of the passes before it.
 
 use crate::backend::{Backend, DeviceLost, Node, Stage};
 use crate::params::{Params, KIND_WALL};

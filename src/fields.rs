@@ -280,7 +280,7 @@ pub const TABLES: [TableDef; 4] = [
     table!("bodies", bodies, 32, true, "Body", Holder::Bodies, 1),
     // Member particle ids, body after body.
     table!("members", members, 1, false, "u32", Holder::Bodies, 0),
-    // One state::Solver per solver slot (backend::schedule::SOLVER_SLOTS).
+    // One state::Solver per solver slot (state::SOLVER_SLOTS).
     table!("solvers", solvers, 8, false, "Solver", Holder::Solvers, 1),
     // Ray-traced laser scenes: this step's beam power split (state::RAYS_*),
     // integer atomics summed in any thread order.

@@ -15,6 +15,7 @@ pub mod host;
 pub mod inspect;
 pub mod kernel;
 pub mod lanes;
+pub mod load;
 pub mod model;
 pub mod outflow;
 pub mod output;

@@ -601,6 +601,19 @@ fn cmd_run(
                 b.absorbed + b.leaving - b.incident,
             );
         }
+        if let Some(s) = &report.laser {
+            let per = if loaded.model.dim == 2 { "/m" } else { "" };
+            println!(
+                "laser (ray-traced, {} samples with the beam on): absorbed fraction {:.4} (per sample {:.4} to {:.4}), mean absorbed {:.4e} W{per} of {:.4e} W{per} incident, {:.3e} W{per} of it at the bounce limit",
+                s.samples,
+                s.absorbed_fraction,
+                s.fraction_min,
+                s.fraction_max,
+                s.absorbed_mean,
+                s.incident_mean,
+                s.at_limit_mean,
+            );
+        }
     }
     if let Some(t) = &report.track {
         for line in t.summary(loaded.model.dim) {
@@ -865,7 +878,7 @@ fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, SpatterError> {
 /// Measured throughputs (particle-steps/s) a scene's cost is projected from,
 /// docs/benchmarks.md: (one H100, 2 CPU cores of the CI machine kind). Plain
 /// WCSPH: the H100 at 1.6e7 particles (2026-11-23), this 2-core machine's CPU
-/// at 1e6 (dam_break_3d, issue 32). Heat and laser scenes: the H100 on
+/// at 1e6 (dam_break_3d). Heat and laser scenes: the H100 on
 /// line_melt_bare_plate (2.8e5 particles, 2026-11-23), the CPU on melt_block_3d.
 const PLAIN_RATES: (f64, f64) = (1.34e8, 1.7e6);
 const HEAT_RATES: (f64, f64) = (3.65e7, 4.3e5);
@@ -935,7 +948,7 @@ fn print_cost(m: &spatter::model::Model, params: &Params, st: &spatter::state::S
     );
 }
 
-/// Hardware adapter: differences by tolerance (DESIGN.md), per field after one
+/// Hardware adapter: differences by tolerance (docs/backends.md), per field after one
 /// free-running step and per pass with each pass started from the CPU state.
 fn print_hardware_comparison(
     report: &compare::CompareReport,

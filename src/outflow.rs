@@ -1,4 +1,4 @@
-//! Particles that have left the simulation (issue 18): how many, of which phase,
+//! Particles that have left the simulation: how many, of which phase,
 //! with how much mass, through which side and when; and the exact mass balance
 //! initial = in the domain + removed.
 //!

@@ -50,7 +50,7 @@ pub const FLAG_MARRONE_VISCOSITY: u32 = 16384;
 pub const FLAG_RAW_DENSITY_DIFFUSION: u32 = 32768;
 /// A phase melts (and the scene has heat): the temperature pass records each
 /// particle's liquidus crossing on cooling and the `solidification_gradient`
-/// dispatch its |∇T| (`State::solidification`, issue 29).
+/// dispatch its |∇T| (`State::solidification`).
 pub const FLAG_SOLIDIFICATION: u32 = 65536;
 /// Divergence-free SPH: its warm-start store is sorted with the particles.
 pub const FLAG_DFSPH: u32 = 131072;
@@ -122,7 +122,7 @@ gpu_struct! {
         /// Half the period per axis, for the minimum-image test.
         pub half_period: glam::Vec4,
         /// A particle below `keep_lo` or above `keep_hi` on an axis has left the
-        /// simulation (issue 18): at an open face, or (wall_layers + 1) Δx behind a
+        /// simulation: at an open face, or (wall_layers + 1) Δx behind a
         /// walled one, the edge of the padded box; ±f32::MAX on periodic and
         /// absent axes.
         pub keep_lo: glam::Vec4,
@@ -849,7 +849,7 @@ impl Params {
     pub fn flag(&self, bit: u32) -> bool {
         self.sizes.flags & bit != 0
     }
-    /// Outside the box a particle must stay in: it has left (issue 18). Twin of
+    /// Outside the box a particle must stay in: it has left. Twin of
     /// `outside_keep_box` in shaders/lib/grid.wgsl.
     #[inline(always)]
     pub fn outside_keep_box(&self, p: &[f32; 4]) -> bool {
@@ -899,7 +899,7 @@ impl Params {
         if t.sahoo_r_gamma > 0.0 {
             let ka = t.sahoo_k_a * pm::exp(t.sahoo_q / t_i);
             let l = pm::ln(1.0 + ka);
-            alpha = alpha - t.sahoo_r_gamma * t_i * l;
+            alpha -= t.sahoo_r_gamma * t_i * l;
             slope = slope - t.sahoo_r_gamma * l - t.sahoo_gamma_h * ka / (t_i * (1.0 + ka));
         }
         if alpha <= t.alpha_min {
@@ -1315,48 +1315,6 @@ fn phase_block(ph: &crate::model::PhaseInfo) -> Phase {
     b
 }
 
-#[cfg(test)]
-mod tests {
-    /// A lattice particle's neighbours inside the support, the sites on its
-    /// edge excluded: the quintic's 3 Δx (24 in 2D: rings of 4, 4, 4, 8, 4;
-    /// 92 in 3D) and a 2 Δx support (8 and 26: |k|² = 4 sits on the edge).
-    #[test]
-    fn lattice_neighbours_count_the_sites_inside_the_support() {
-        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 3.0e-3), 24);
-        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 3.0e-3), 92);
-        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 2.0e-3), 8);
-        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 2.0e-3), 26);
-    }
-
-    /// κ for the three kernels at the h/Δx where it was measured by the absorbed
-    /// power on a flat plate without normalisation (quintic at Δx 1.0595,
-    /// Wendland at 1.2Δx 1.0284, the cubic at Δx 1.1081; at today's defaults
-    /// tests/heat.rs holds the normalised absorbed power to 1%).
-    #[test]
-    fn surface_delta_integral_matches_the_flat_plate_measurement() {
-        let expected = [
-            ("quintic", 1.0, 1.0595),
-            ("wendland_c2", 1.2, 1.0284),
-            ("cubic", 1.0, 1.1081),
-        ];
-        for (k, h_over_dx, kappa) in expected {
-            let path = concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/scenarios/validation/laser_flat_plate.toml"
-            );
-            let sets = vec![
-                format!("kernel=\"{k}\""),
-                format!("h_over_dx={h_over_dx}"),
-                "laser.model=\"gaussian_surface\"".to_string(),
-            ];
-            let l = crate::run::load(path, &sets).unwrap();
-            let p = super::Params::new(&l.model, l.state.len() as u32);
-            let got = super::surface_delta_integral(&p, l.model.dx);
-            assert!((got - kappa).abs() < 1e-4, "{k}: {got}");
-        }
-    }
-}
-
 /// W(r) in f64 (host-side setup), the kernels of `kernel_sigma`.
 pub fn kernel_w_f64(kind: KernelKind, dim: u32, h: f64, r: f64) -> f64 {
     let q = r / h;
@@ -1417,4 +1375,18 @@ pub fn lattice_density_ratio(kind: KernelKind, dim: u32, h: f64, dx: f64, suppor
     let mut sum = 0.0;
     for_each_lattice_site(dim, dx, support, |r| sum += kernel_w_f64(kind, dim, h, r));
     sum * dx.powi(dim as i32)
+}
+
+#[cfg(test)]
+mod tests {
+    /// A lattice particle's neighbours inside the support, the sites on its
+    /// edge excluded: the quintic's 3 Δx (24 in 2D: rings of 4, 4, 4, 8, 4;
+    /// 92 in 3D) and a 2 Δx support (8 and 26: |k|² = 4 sits on the edge).
+    #[test]
+    fn lattice_neighbours_count_the_sites_inside_the_support() {
+        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 3.0e-3), 24);
+        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 3.0e-3), 92);
+        assert_eq!(super::lattice_neighbours(2, 1.0e-3, 2.0e-3), 8);
+        assert_eq!(super::lattice_neighbours(3, 1.0e-3, 2.0e-3), 26);
+    }
 }

@@ -1,4 +1,4 @@
-//! The melt pool of a state (issue 29 item 1): the largest connected region of
+//! The melt pool of a state: the largest connected region of
 //! melt, and the detached melt beside it (splashed droplets, molten grains not
 //! yet joined to the pool). Host side, in f64, from a state read back.
 //!

@@ -118,6 +118,24 @@ pub fn solve_symmetric(dim: u32, m: [f32; 6], b: [f32; 3]) -> [f32; 3] {
     g
 }
 
+/// sin(2π x) for x in cycles (a temperature program's phase t/P): x reduced to
+/// f ∈ [−¼, ¼] by sin's period and its symmetry about ¼ cycle, then the
+/// Taylor polynomial of θ = 2π f. Finite x only; |x| up to 2^22 keeps f to
+/// 2^-2 cycles' ULP (a program runs a few hundred cycles).
+pub fn sin_cycles(x: f32) -> f32 {
+    let mut f = x - (x + 0.5).floor();
+    if f > 0.25 {
+        f = 0.5 - f;
+    } else if f < -0.25 {
+        f = -0.5 - f;
+    }
+    let th = f * std::f32::consts::TAU;
+    let z = th * th;
+    let c = &SIN_C;
+    let p = c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * c[4])));
+    th + th * (z * p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -205,22 +223,4 @@ mod tests {
             "pow exceeds the error-propagation bound by {worst}x"
         );
     }
-}
-
-/// sin(2π x) for x in cycles (a temperature program's phase t/P): x reduced to
-/// f ∈ [−¼, ¼] by sin's period and its symmetry about ¼ cycle, then the
-/// Taylor polynomial of θ = 2π f. Finite x only; |x| up to 2^22 keeps f to
-/// 2^-2 cycles' ULP (a program runs a few hundred cycles).
-pub fn sin_cycles(x: f32) -> f32 {
-    let mut f = x - (x + 0.5).floor();
-    if f > 0.25 {
-        f = 0.5 - f;
-    } else if f < -0.25 {
-        f = -0.5 - f;
-    }
-    let th = f * std::f32::consts::TAU;
-    let z = th * th;
-    let c = &SIN_C;
-    let p = c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * c[4])));
-    th + th * (z * p)
 }

@@ -1,4 +1,4 @@
-//! Powder-bed generator (issue 17 item 5): grains of log-normal diameter,
+//! Powder-bed generator: grains of log-normal diameter,
 //! clipped to a range, poured one at a time into the scene's `[powder]` box
 //! and levelled at its top, as a recoater does.
 //!
@@ -19,8 +19,9 @@
 //! where large ones are removed). Deterministic: the same keys and seed give the same bed.
 //!
 //! The vertical is the last axis (y in 2D, z in 3D); in 2D the grains are discs.
-//! The grains are fixed solid particles for now (a lattice fill of each grain's
-//! sphere with the powder phase); rigid bodies come with the rest of issue 17.
+//! Each grain is a lattice fill of its sphere with the powder phase: fixed
+//! solid particles, or with `[powder] rigid = true` one rigid body per grain
+//! (model/bodies.rs, crate::bodies).
 
 use crate::error::InputError;
 use crate::random::SplitMix;
@@ -581,8 +582,8 @@ mod tests {
     }
 
     /// A poured 3D bed: no two grains overlap (beyond 1e-9 of a radius), every
-    /// grain inside the box, the packing fraction in the poured range 0.5–0.65
-    /// (the issue), and the same seed gives the same bed.
+    /// grain inside the box, the packing fraction in the poured range 0.5–0.65,
+    /// and the same seed gives the same bed.
     #[test]
     fn poured_bed_is_packed_and_deterministic() {
         let b = bed(3, 7);

@@ -1,4 +1,4 @@
-//! Loading a scene, choosing a backend and driving the step loop.
+//! Choosing a backend and driving the step loop (a scene is loaded by `load`).
 
 pub(crate) mod observers;
 pub mod pool_csv;
@@ -9,16 +9,15 @@ pub use observers::{Findings, Moment, Observer};
 use crate::backend::cpu::CpuBackend;
 use crate::backend::gpu::{AdapterChoice, GpuBackend, GpuContext};
 use crate::backend::{Backend, DeviceLost};
-use crate::checkpoint::{self, CheckpointSink};
+use crate::checkpoint::CheckpointSink;
 use crate::checks::CheckResult;
 use crate::diagnostics::{self, Leakage, BODIES_TOPIC, DIAGNOSTICS_TOPIC, REMOVED_TOPIC};
-use crate::error::{InputError, SpatterError};
-use crate::model::{self, EndCondition, Model};
+use crate::error::SpatterError;
+pub use crate::load::{load, load_checkpoint, load_str, Loaded};
+use crate::model::{EndCondition, Model};
 use crate::outflow::RemovalLog;
 use crate::output::{mcap_out::McapSink, vtk::VtkSink};
 use crate::params::Params;
-use crate::scene;
-use crate::setup;
 use crate::state::{dt_limit_name, State};
 use crate::watchdog::{self, Trip};
 use std::io::IsTerminal;
@@ -31,82 +30,6 @@ pub enum BackendChoice {
     Auto,
     Gpu,
     Cpu,
-}
-
-/// A scene ready to run: validated model and initial particles.
-pub struct Loaded {
-    pub model: Model,
-    pub state: State,
-}
-
-pub fn load(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(path, "", format!("cannot read scenario: {e}")))?;
-    load_str(path, &text, sets)
-}
-
-/// A scene from scenario text (named `label` in messages): the benchmarks' scenes
-/// are compiled into the binary.
-pub fn load_str(label: &str, text: &str, sets: &[String]) -> Result<Loaded, InputError> {
-    let (scene, resolved) = scene::parse_str(label, text, sets)?;
-    let mut model = model::build(label, &scene, &resolved)?;
-    let state = setup::generate(&model, &scene)?;
-    attach_grains(&mut model, &state);
-    Ok(Loaded { model, state })
-}
-
-/// A powder scene's grain of each particle id, from the initial state.
-fn attach_grains(model: &mut Model, initial: &State) {
-    if model.powder.is_none() {
-        return;
-    }
-    let particles: Vec<(u32, u32, [f64; 3])> = (0..initial.len())
-        .map(|i| {
-            (
-                initial.id[i],
-                initial.phase[i],
-                model.to_world(initial.pos[i]),
-            )
-        })
-        .collect();
-    let dim = model.dim as usize;
-    if let Some(b) = model.powder.as_mut() {
-        b.attach(dim, initial.len(), particles);
-    }
-}
-
-/// A run continued from a checkpoint: its stored scenario (with any `--set`
-/// applied on top) and its state.
-pub fn load_checkpoint(path: &str, sets: &[String]) -> Result<Loaded, InputError> {
-    let ck = checkpoint::load(path)?;
-    let label = format!("{path} (stored scenario {})", ck.header.scenario_file);
-    let (scene, resolved) = scene::parse_str(&label, &ck.header.scenario, sets)?;
-    let mut model = model::build(&label, &scene, &resolved)?;
-    if model.powder.is_some() {
-        // Grain membership comes from the initial lattice fill, which the
-        // checkpoint no longer shows (melt moves): regenerate it.
-        let initial = setup::generate(&model, &scene)?;
-        attach_grains(&mut model, &initial);
-    }
-    model.file = ck.header.scenario_file.clone();
-    if ck
-        .state
-        .phase
-        .iter()
-        .any(|&p| p as usize >= model.phases.len())
-    {
-        return Err(InputError::new(
-            path,
-            "",
-            "checkpoint phases do not match its scenario",
-        ));
-    }
-    let mut state = ck.state;
-    if model.melts() && state.solidification.is_empty() {
-        // A checkpoint written before the solidification record existed.
-        state.solidification = setup::unrecorded_solidification(state.len());
-    }
-    Ok(Loaded { model, state })
 }
 
 pub fn make_backend(
@@ -160,14 +83,16 @@ pub struct RunReport {
     pub end: RunEnd,
     /// The checkpoint written last, if any.
     pub last_checkpoint: Option<PathBuf>,
-    /// Wall leakage over every state the run read back (issue 18).
+    /// Wall leakage over every state the run read back.
     pub leakage: Leakage,
-    /// The melt track of a laser scene (issue 16).
+    /// The melt track of a laser scene.
     pub track: Option<crate::track::TrackProfile>,
     /// Why the run ended before its end time (`run.stop_when`).
     pub stop_reason: Option<String>,
-    /// Where and how the metal froze, in scenes with a melting phase (issue 29).
+    /// Where and how the metal froze, in scenes with a melting phase.
     pub solidification: Option<crate::solidification::Summary>,
+    /// The ray-traced laser's absorbed fraction over the states read back.
+    pub laser: Option<crate::diagnostics::LaserSummary>,
 }
 
 impl RunReport {
@@ -379,6 +304,7 @@ impl Progress {
             start: Instant::now(),
         }
     }
+    #[allow(clippy::too_many_arguments)] // one progress line's figures, read where the loop has them
     fn update(
         &mut self,
         quiet: bool,
@@ -579,10 +505,11 @@ pub fn run(
         track: found.track,
         stop_reason,
         solidification,
+        laser: found.laser,
     })
 }
 
-/// `run.stop_when = "solidified"` (issue 29 item 5): why the run stops at the
+/// `run.stop_when = "solidified"`: why the run stops at the
 /// sample `st`, if it does: the beam is off for good and no melt is left, or the
 /// grace after the beam went off has passed.
 fn solidified(m: &Model, st: &State) -> Option<String> {
@@ -801,7 +728,7 @@ mod tests {
             .last_checkpoint
             .clone()
             .expect("checkpoint of the last good state");
-        let c = checkpoint::load(&ckpt.to_string_lossy()).unwrap();
+        let c = crate::checkpoint::load(&ckpt.to_string_lossy()).unwrap();
         assert!(
             c.state.sim.step > 0,
             "a state after the first chunk was kept"

@@ -472,7 +472,8 @@ pub struct Simulation {
     #[serde(default)]
     pub background_pressure: f64,
     /// Clamp the equation of state at p >= 0. Needed for single-phase free surfaces,
-    /// where summation density is deficient near the surface (PHYSICS.md §2a).
+    /// where summation density is deficient near the surface (docs/physics.md,
+    /// formulation `wcsph`).
     #[serde(default)]
     pub pressure_floor: bool,
     /// `zero` (default) or `hydrostatic`: start each fluid particle at the pressure
@@ -632,7 +633,8 @@ pub struct Domain {
     pub open_sides_policy: OpenSidesPolicy,
 }
 
-/// `domain.open_sides_policy` (issue 18).
+/// `domain.open_sides_policy`: what happens when a particle leaves through an
+/// open side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum OpenSidesPolicy {
@@ -882,7 +884,7 @@ pub struct RunDef {
     pub dt_check: Option<bool>,
     /// "solidified": end a laser run at the first sample after the beam is off
     /// for good with no melt left (liquid fraction ≥ ½), or `stop_grace`
-    /// seconds after the beam went off, whichever comes first (issue 29).
+    /// seconds after the beam went off, whichever comes first.
     pub stop_when: Option<StopWhen>,
     /// s after the beam goes off (default: none, only the melt's end stops it).
     pub stop_grace: Option<f64>,
@@ -895,7 +897,7 @@ pub enum StopWhen {
     Solidified,
 }
 
-/// Instability watchdog thresholds (issue 3). Densities are relative to each
+/// Instability watchdog thresholds. Densities are relative to each
 /// phase's ρ0, the Δt floor to the initial F22 (42) limit.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -912,7 +914,7 @@ pub struct WatchdogDef {
     /// Absent (the default): only when it has passed through all the wall layers
     /// (as many Δx as the layers); shallower leaks are measured and warned about.
     pub wall_penetration: Option<f64>,
-    /// Scenes with a liquid and a gas (issue 29): the share of liquid particles
+    /// Scenes with a liquid and a gas: the share of liquid particles
     /// with no liquid, solid or wall particle within 1.5 Δx (alone in the gas)
     /// above which the liquid counts as dispersing into its gas (default 0.05;
     /// at least 10 such particles). A drop that holds together has none: a

@@ -420,7 +420,7 @@ pub fn generate(m: &Model, scene: &SceneFile) -> Result<State, InputError> {
         st.solidification = unrecorded_solidification(st.len());
     }
     if held.solvers {
-        st.solvers = vec![crate::state::Solver::default(); crate::backend::SOLVER_SLOTS.len()];
+        st.solvers = vec![crate::state::Solver::default(); crate::state::SOLVER_SLOTS.len()];
     }
     if m.laser.as_ref().is_some_and(|l| l.rays.is_some()) {
         st.laser_rays = vec![0; 4];

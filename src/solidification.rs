@@ -1,4 +1,4 @@
-//! The solidification record (issue 29 item 2): where, when and under what
+//! The solidification record: where, when and under what
 //! thermal conditions the metal froze, the inputs of a columnar/equiaxed map
 //! (Hunt 1984, Gäumann et al. 2001) and of grain-structure codes that take G and R
 //! from a melt-pool simulation.
@@ -201,7 +201,7 @@ pub fn schema() -> serde_json::Value {
     serde_json::json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "spatter.Solidification",
-        "description": "Liquidus crossings on cooling recorded since the previous sample, one column entry per particle (issue 29): the last crossing of each particle when it crossed more than once between samples.",
+        "description": "Liquidus crossings on cooling recorded since the previous sample, one column entry per particle: the last crossing of each particle when it crossed more than once between samples.",
         "type": "object",
         "properties": {
             "time": {"type": "number", "description": "the sample's time, s"},

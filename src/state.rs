@@ -14,7 +14,7 @@ pub struct Sim {
     pub dt_limit: u32,
     pub umax2: f32,
     pub amax2: f32,
-    /// Particles taken out of the simulation (issue 18): the neighbour pass sorts
+    /// Particles taken out of the simulation: the neighbour pass sorts
     /// them after every cell, so they are the last `removed` of the arrays, and
     /// every other pass stops at `n − removed`. Counted by that pass each step.
     pub removed: u32,
@@ -98,7 +98,7 @@ pub struct State {
     /// iteration's |ḣ_k − ḣ_{k−1}|.
     pub heat_start: Vec<[f32; 4]>,
     /// Scenes whose schedule holds a repeat (empty otherwise): one entry per
-    /// solver slot (backend::schedule::SOLVER_SLOTS), this step's iterations,
+    /// solver slot (SOLVER_SLOTS, below), this step's iterations,
     /// flag and residual.
     pub solvers: Vec<Solver>,
     /// Ray-traced laser scenes (empty otherwise): this step's beam power in
@@ -108,8 +108,8 @@ pub struct State {
     pub laser_rays: Vec<u32>,
     /// Scenes with a phase that melts, and heat (empty otherwise), 2n entries
     /// indexed by particle id (`solidification[id]`, `solidification[n + id]`),
-    /// not sorted: the record of the particle's last liquidus crossing on cooling
-    /// (issue 29). First (time of the crossing, |∇T| there (K/m; −1 until the
+    /// not sorted: the record of the particle's last liquidus crossing on cooling.
+    /// First (time of the crossing, |∇T| there (K/m; −1 until the
     /// gradient dispatch has computed it), cooling rate −dT/dt (K/s), crossings so
     /// far); then (position xyz at the crossing, 1 while the gradient is pending).
     pub solidification: Vec<[f32; 4]>,
@@ -326,3 +326,26 @@ impl State {
 pub const BYTES_PER_PARTICLE_SORT: u64 = 16;
 /// Bytes per grid cell: start and end tables.
 pub const BYTES_PER_CELL: u64 = 8;
+
+/// Solver slots: one `Solver` entry (iterations, converged flag, residual) per
+/// repeat a scene's schedule can hold, in `State::solvers` and the `solvers`
+/// buffer. The WGSL names the same slots (`SOLVER_*` in shaders/lib/params.wgsl).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolverSlot {
+    /// R18 Algorithm 3.1: the trapezoidal heat iteration.
+    Heat = 0,
+    /// DFSPH's constant-density solve.
+    Density = 1,
+    /// DFSPH's divergence-free solve.
+    Divergence = 2,
+    /// DFSPH's implicit viscosity (conjugate gradients).
+    Viscosity = 3,
+}
+
+/// Solver slots in the `solvers` buffer (every scene with a repeat holds them all).
+pub const SOLVER_SLOTS: [(SolverSlot, &str); 4] = [
+    (SolverSlot::Heat, "heat"),
+    (SolverSlot::Density, "dfsph_density"),
+    (SolverSlot::Divergence, "dfsph_divergence"),
+    (SolverSlot::Viscosity, "dfsph_viscosity"),
+];

@@ -1,4 +1,4 @@
-//! Process maps (issue 29 item 3): a grid of `--set` overrides over one scene,
+//! Process maps: a grid of `--set` overrides over one scene,
 //! run on this machine N at a time or as a Slurm job array, and the figures of
 //! every run gathered into one CSV and a map.
 //!
@@ -276,6 +276,7 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
         "laser_radius": m.laser.as_ref().map(|l| l.radius),
         "laser_peak_power": m.laser.as_ref().map(|l| l.power.iter().map(|p| p.1).fold(0.0, f64::max)),
         "track": track,
+        "laser": r.laser,
         "check": r.check.as_ref().map(|c| serde_json::json!({
             "name": c.name, "value": c.value, "tolerance": c.tolerance, "pass": c.pass,
             "figures": c.figures.iter().map(|(k, v)| (k.clone(), serde_json::json!(v)))

@@ -1,4 +1,4 @@
-//! The melt track a laser scan leaves (issue 16 item 7): per slice of width Δx
+//! The melt track a laser scan leaves: per slice of width Δx
 //! along x (the scan axis of the scenes), the depth the melt reached below the
 //! initial surface, the track's width (3D), the height of the resolidified
 //! surface relative to the initial one and the peak temperature; and the melt

@@ -1,4 +1,4 @@
-//! Instability watchdog (issue 3): scans a state for the first sign that a run has
+//! Instability watchdog: scans a state for the first sign that a run has
 //! gone wrong and names the step, time, particle, field and value.
 //!
 //! It looks at every state the run reads back (each diagnostics interval) and at
@@ -117,7 +117,7 @@ pub fn scan(m: &Model, st: &State) -> Option<Trip> {
 /// few molten particles of a melt pool under gas may have no liquid beside them).
 pub const MIN_DISPERSED: usize = 10;
 
-/// A liquid dispersing into its gas (issue 29): its particles with no liquid,
+/// A liquid dispersing into its gas: its particles with no liquid,
 /// solid or wall particle within 1.5 Δx (crate::pool::LINK_DX). Without gas, a
 /// free surface under tension breaking up: its particles in fragments too small
 /// for the kernel to resolve (`fragment_limit`). A gas-free liquid torn apart
@@ -353,7 +353,7 @@ fn wall_trip(
     (AXES[a], m.to_world(st.pos[i])[a], what)
 }
 
-/// A particle the step removed (issue 18): leaving through an open side is normal
+/// A particle the step removed: leaving through an open side is normal
 /// unless the scene's policy is "stop"; leaving behind a walled side means it went
 /// through every wall layer, which always stops the run.
 fn removal_problem(m: &Model, st: &State, i: usize) -> Option<(&'static str, f64, String)> {
@@ -387,7 +387,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/dam_break_2d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         (l.model, l.state)
     }
 
@@ -502,7 +502,7 @@ mod tests {
         assert!(check_sim(&free, &sim, f32::MAX).is_none());
     }
 
-    /// Issue 29: liquid particles alone in the gas past the scene's share stop
+    /// Liquid particles alone in the gas past the scene's share stop
     /// the run (the lowest id named), or only warn; a drop that holds together
     /// and a share below the bound pass.
     #[test]
@@ -511,7 +511,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/square_drop_2d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let (mut m, mut st) = (l.model, l.state);
         assert_eq!(scan(&m, &st), None);
         let liquid: Vec<usize> = (0..st.len())
@@ -549,7 +549,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/laplace_free_disc_2d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let (m, mut st) = (l.model, l.state);
         assert_eq!(fragment_limit(2), 7);
         assert_eq!(fragment_limit(3), 14);
@@ -601,7 +601,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/dam_break_2d.toml"
         );
-        let l = crate::run::load(dam, &[]).unwrap();
+        let l = crate::load::load(dam, &[]).unwrap();
         assert!(dispersion(&l.model, &l.state).is_none());
     }
 }

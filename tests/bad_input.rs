@@ -67,9 +67,10 @@ fn missing_file_exits_2() {
     assert!(text(&out).1.contains("/nonexistent/scene.toml"));
 }
 
-/// The formulation and heat-integration keys of issues 27–28: each wrong
-/// combination exits 2 naming its key; δ-SPH with a pressure floor validates
-/// with a warning naming `simulation.pressure_floor`.
+/// The formulation and heat-integration keys (δ-SPH's `simulation.delta`,
+/// `density_diffusion` and `viscosity_form`; `[heat]`'s integrator and its
+/// iterations): each wrong combination exits 2 naming its key; δ-SPH with a
+/// pressure floor validates with a warning naming `simulation.pressure_floor`.
 #[test]
 fn formulation_and_heat_integration_keys() {
     let dam = common::scene("dam_break_2d");

@@ -1,4 +1,4 @@
-//! `bench accuracy --quick` and `bench stability --quick` as CI runs them (issue 15):
+//! `bench accuracy --quick` and `bench stability --quick` as CI runs them:
 //! their JSON holds finite figures, errors fall with Δx where the method converges,
 //! and no stability case crashes.
 
@@ -23,7 +23,7 @@ fn num(v: &Value, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("{key} missing in {v}"))
 }
 
-/// Issue 15: for Poiseuille, Couette, conduction_1d and Stefan the error falls with
+/// For Poiseuille, Couette, conduction_1d and Stefan the error falls with
 /// Δx. Measured (quick pair, quintic, 2026-12-02): Poiseuille 7.96e-3 → 4.49e-3 and
 /// Couette 9.26e-4 → 5.17e-4 (order 2.0), Stefan 4.07e-3 → 3.38e-3 (0.8), and
 /// conduction_1d 1.69e-3 → 1.62e-3: already on its discretisation floor (order 0.2,

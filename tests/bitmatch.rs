@@ -1,4 +1,4 @@
-//! Bit-match contract (DESIGN.md): on the software adapter (lavapipe) the GPU passes
+//! Bit-match contract (docs/backends.md): on the software adapter (lavapipe) the GPU passes
 //! give the same bits as their CPU twins, every field after every pass of 200 steps.
 
 mod common;
@@ -8,7 +8,7 @@ use spatter::compare::{compare, CompareMode, ToleranceScales};
 use spatter::params::Params;
 use spatter::run::load;
 
-/// Returns the particles removed by the end (issue 18).
+/// Returns the particles removed by the end.
 fn assert_bit_identical(name: &str, sets: &[&str], steps: u64) -> u32 {
     assert_bit_identical_at(&common::scene(name), sets, steps).removed
 }
@@ -66,7 +66,7 @@ fn dam_break_2d_200_steps() {
     assert_bit_identical("dam_break_2d", &[], 200);
 }
 
-/// Issue 18: particles leave through an open side (from step 111 on), are sorted
+/// Particles leave through an open side (from step 111 on), are sorted
 /// after every cell and skipped by every pass, the same on both backends.
 #[test]
 fn jet_outflow_2d_with_removals_200_steps() {
@@ -149,7 +149,7 @@ fn wendland_and_cubic_kernels_50_steps() {
     assert_bit_identical("dam_break_3d", &["kernel=\"cubic\"", "dx=0.02"], 50);
 }
 
-/// The command issue 2 names, as a user runs it, over 50 steps: the library
+/// The `spatter compare` command, as a user runs it, over 50 steps: the library
 /// cases run dam_break_3d 200 steps (heat_in_a_flowing_liquid_3d_200_steps,
 /// dfsph_dam_break_2d_and_3d_200_steps); 200 here cost CI about 40 s more.
 #[test]
@@ -163,14 +163,14 @@ fn compare_cli_dam_break_3d_50_steps() {
     assert_eq!(out.status.code(), Some(0));
 }
 
-/// Heat (issue 4): conduction with Dirichlet walls and two materials, melting
+/// Heat: conduction with Dirichlet walls and two materials, melting
 /// through the enthalpy band, an adiabatic box, and heat carried by a flowing 3D
 /// liquid (reordered every step with the other arrays).
 #[test]
 fn heat_passes_200_steps() {
     assert_bit_identical("stefan_1d", &[], 200);
     assert_bit_identical("conduction_two_materials", &[], 200);
-    // h(T) and λ(T) from tables (issue 30).
+    // h(T) and λ(T) from tables.
     assert_bit_identical("conduction_tables_2d", &[], 200);
     assert_bit_identical("adiabatic_box", &[], 200);
     assert_bit_identical("laser_flat_plate", &[], 200);
@@ -236,7 +236,7 @@ fn heat_in_a_flowing_liquid_2d_200_steps() {
     assert_bit_identical("dam_break_2d", &HOT_WATER, 200);
 }
 
-/// Issue 4: the melt block over 200 steps, through the start of melting (solid
+/// The melt block over 200 steps, through the start of melting (solid
 /// particles switching to liquid and flowing) under the surface laser: interface,
 /// laser, heat and phase passes.
 #[test]
@@ -271,7 +271,7 @@ fn melt_block_small_3d() -> String {
     })
 }
 
-/// A repeat node (issue 27): R18's trapezoidal heat, a fixed-point
+/// A repeat node: R18's trapezoidal heat, a fixed-point
 /// iteration ended by the device's converged flag, with Dirichlet mirror walls
 /// at the conduction limit's Δt (conduction_1d: the iteration contracts by about
 /// 0.46 per round there, so 1e-3 takes ~9), through the melting band (stefan_1d)
@@ -302,7 +302,7 @@ fn implicit_heat_repeat() {
 
 const DELTA: &str = "simulation.formulation=\"delta_wcsph\"";
 
-/// Issue 28: R18's δ-SPH (continuity density, the same-phase density diffusion,
+/// R18's δ-SPH (continuity density, the same-phase density diffusion,
 /// the Shepard pressure R18 (3.17); sorted density), 2D and 3D: a dam break
 /// against walls, liquid under gas at density ratio 1000, the free-surface
 /// tension disc, and R18 (3.18)'s viscosity option in a channel.
@@ -437,7 +437,7 @@ fn tolerance_mode_is_exact_on_the_software_adapter() {
     }
 }
 
-/// Issue 16: CSF surface tension with gas particles (curvature, the liquid's
+/// CSF surface tension with gas particles (curvature, the liquid's
 /// force), isothermal, 200 steps of the Laplace disc.
 #[test]
 fn surface_tension_static_drop_200_steps() {
@@ -481,7 +481,7 @@ fn surface_tension_with_temperature_200_steps() {
     assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
 }
 
-/// Issue 16: surface tension in the free-surface form (R18, no gas particles):
+/// Surface tension in the free-surface form (R18, no gas particles):
 /// capped curvature, its smoothing, the force with ρ0; 200 steps of the free disc.
 #[test]
 fn free_surface_tension_static_drop_200_steps() {
@@ -548,7 +548,7 @@ fn free_surface_tension_with_temperature_200_steps() {
     assert_bit_identical_at(path.to_str().unwrap(), &[], 200);
 }
 
-/// Issue 16 item 8: the line-melt scene with every force it has (the README's
+/// The line-melt scene with every force it has (the README's
 /// first command: heat, melting, the surface laser, evaporation, recoil, surface
 /// tension with Marangoni in the free-surface form, on δ-SPH, with R18 §4.4's
 /// rule for thin layers), 200 steps. The plate starts
@@ -639,7 +639,7 @@ fn ray_traced(text: &str) -> String {
     out
 }
 
-/// Issue 16 item 3: wetting by a prescribed normal (F22 (27)–(29)), the sessile
+/// Wetting by a prescribed normal (F22 (27)–(29)), the sessile
 /// drop at 60° spreading on its wall, 200 steps.
 #[test]
 fn wetting_sessile_drop_200_steps() {
@@ -665,7 +665,7 @@ fn free_surface_wetting_and_interface_viscosity_200_steps() {
     );
 }
 
-/// Issue 16 item 8: the thermocapillary channel (Marangoni flow between a wall
+/// The thermocapillary channel (Marangoni flow between a wall
 /// heated as a cosine and a cold one), 200 steps: every Dirichlet wall particle
 /// mirrors its own fixed temperature (heat.x), the Marangoni term along a flat
 /// interface, conduction through both fluids.
@@ -775,7 +775,7 @@ angular_velocity = [1.0]
 
 "#;
 
-/// Issue 17: rigid bodies in a 2D tank of water, 200 steps. Two boxes side by
+/// Rigid bodies in a 2D tank of water, 200 steps. Two boxes side by
 /// side spin and move into each other, a disc is thrown at the floor and a
 /// third box falls into the water: contact between bodies and with walls from
 /// the first steps, the fluid's reaction on every body particle near water,
@@ -821,7 +821,7 @@ steps = 200
     );
 }
 
-/// Issue 17: rigid bodies in 3D, 200 steps: a tumbling block hits a sphere, a
+/// Rigid bodies in 3D, 200 steps: a tumbling block hits a sphere, a
 /// second block lands on the floor beside a pool of water.
 #[test]
 fn rigid_bodies_3d_200_steps() {
@@ -915,7 +915,7 @@ fn bit_identical_text_with(
     bit_identical_state(path.to_str().unwrap(), sets, steps)
 }
 
-/// Issue 17 item 4: a rigid grain melting in a pool (the melting-grain check's
+/// A rigid grain melting in a pool (the melting-grain check's
 /// scene with the grain just below its solidus, so that 10 of its 52 particles
 /// leave in 200 steps): body_melt's departures (material velocity, own force),
 /// the recomputed mass, centre and principal axes (f32 Jacobi) and F22 (37);
@@ -928,7 +928,7 @@ fn melting_grain_2d_200_steps() {
         &[
             "phases.grain.temperature=1690.0",
             "simulation.solid_fluid_viscosity={coefficient=1.0, width=300.0}",
-            // The barrier's reaction on the grain too (issue 27).
+            // The barrier's reaction on the grain too.
             "simulation.barrier={radius_dx=0.9, stiffness=1.0e4, damping=1.0e-2}",
         ],
         200,
@@ -937,7 +937,7 @@ fn melting_grain_2d_200_steps() {
     assert!(b.count < b.initial_count && b.count > 0, "{b:?}");
 }
 
-/// Issue 17 item 4: melt that solidifies against rigid grains bonds them into
+/// Melt that solidifies against rigid grains bonds them into
 /// the substrate (body_bond, then body_melt's bonding), 200 steps: a cold grain
 /// resting on a cold plate under a layer of melt at 1750 K; a second grain
 /// falls towards the melt.
@@ -949,7 +949,7 @@ fn bonding_grains_2d_200_steps() {
     assert_eq!(st.bodies[1].bonded, 0, "the falling grain is still free");
 }
 
-/// Issue 17 item 4 in 3D: a grain just below its solidus in a pool of melt at
+/// In 3D: a grain just below its solidus in a pool of melt at
 /// 2500 K, weightless, 200 steps: departures and the full 3D Jacobi (every
 /// off-diagonal entry is non-zero once members leave unevenly).
 #[test]
@@ -1017,7 +1017,7 @@ steps = 200
     assert!(b.count < b.initial_count, "{b:?}");
 }
 
-/// Issue 17: a bed of 1000 rigid grains (the bed-at-rest scene widened to
+/// A bed of 1000 rigid grains (the bed-at-rest scene widened to
 /// 2.4 mm and poured with exactly 1000 grains: 2D, 16–32 µm discs at Δx = 5 µm,
 /// 18 278 particles), 200 steps: contact between grains and with the holder,
 /// per-body sums over 1000 bodies.
@@ -1039,7 +1039,7 @@ fn powder_bed_of_1000_rigid_grains_200_steps() {
 
 const DFSPH: &str = "simulation.formulation=\"dfsph\"";
 
-/// Issue 30: a DFSPH droplet with heat hits a cold free-slip wall (J22's
+/// A DFSPH droplet with heat hits a cold free-slip wall (J22's
 /// Fluent case, 2D at Δx = 4 µm): the implicit viscosity with XSPH, J22's
 /// cohesion and adhesion, the free-surface tension, the conduction into the
 /// Dirichlet wall and the mushy-zone sink as the melt freezes, 150 steps (the
@@ -1074,7 +1074,7 @@ fn dfsph_spray_droplet_150_steps() {
     );
 }
 
-/// Issue 30: DFSPH's factor, both pressure solves and the implicit viscosity
+/// DFSPH's factor, both pressure solves and the implicit viscosity
 /// with XSPH (repeats: every iteration's dispatches, the tree-summed
 /// residuals and dot products, the converged flags), the walls' head and
 /// no-slip velocities, predict and drift: a 2D dam break (free surface,
@@ -1101,7 +1101,7 @@ fn dfsph_dam_break_2d_and_3d_200_steps() {
     assert_bit_identical("dam_break_3d", &coarse, 200);
 }
 
-/// Issue 30: the divergence solve skips a particle with fewer than a
+/// The divergence solve skips a particle with fewer than a
 /// quarter of the lattice's neighbours (spray) on both twins: a lone pair
 /// meeting at 2.999 Δx, where the solve without the rule read 4e15 Pa.
 #[test]

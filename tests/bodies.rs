@@ -1,5 +1,5 @@
-//! Issue 17 items 1–3 and 6: rigid bodies (src/bodies.rs, backend::cpu::bodies,
-//! shaders/bodies.wgsl) through the command line: the checks of the issue, bad
+//! Rigid bodies (src/bodies.rs, backend::cpu::bodies, shaders/bodies.wgsl)
+//! through the command line: the rigid-body checks and their tolerances, bad
 //! input, resume, the `/bodies` channel. The bit-match is in tests/bitmatch.rs.
 
 mod common;
@@ -11,20 +11,18 @@ use spatter::bodies::BodyTally;
 use spatter::checks::CheckResult;
 use spatter::model::EndCondition;
 
-/// The restitution coefficient against its analytic value: within 1% (the
-/// issue).
+/// The restitution coefficient against its analytic value: within 1%.
 const RESTITUTION_TOLERANCE: f64 = 0.01;
 /// The same at the contact limit's own step (10 steps per contact): 5%, the
 /// force's jump at the first touch resolved to one step.
 const COARSE_RESTITUTION_TOLERANCE: f64 = 0.05;
-/// A free body's world angular momentum: max |L − L0|/|L0| within 1e-5 (the
-/// issue); it is the state and no torque acts, so it is kept exactly.
+/// A free body's world angular momentum: max |L − L0|/|L0| within 1e-5; it
+/// is the state and no torque acts, so it is kept exactly.
 const ANGULAR_MOMENTUM_TOLERANCE: f64 = 1e-5;
-/// Its rotational energy: max |E − E0|/E0 within 1e-4 (the issue; measured
-/// 1.3e-5, the orientation's f32 rounding).
+/// Its rotational energy: max |E − E0|/E0 within 1e-4 (measured 1.3e-5, the
+/// orientation's f32 rounding).
 const ENERGY_TOLERANCE: f64 = 1e-4;
-/// The floating box's immersed depth against h ρ_b/ρ_l: within one Δx (the
-/// issue).
+/// The floating box's immersed depth against h ρ_b/ρ_l: within one Δx.
 const FLOTATION_TOLERANCE: f64 = 1.0;
 /// A settled bed: no grain moves more than 0.1Δx over the last 10 340 steps.
 const AT_REST_TOLERANCE: f64 = 0.1;
@@ -32,7 +30,7 @@ const AT_REST_TOLERANCE: f64 = 0.1;
 /// |P0|, between the f32 rounding left (5.4e-7 measured) and a departing
 /// particle's dropped force (1.9e-5 measured in a first version).
 const MELTING_GRAIN_TOLERANCE: f64 = 1e-5;
-/// The settling disc against Faxén's terminal velocity: within 5% (the issue).
+/// The settling disc against Faxén's terminal velocity: within 5%.
 const SETTLING_TOLERANCE: f64 = 0.05;
 
 /// Scene `name` with overrides, run on the CPU to `end` (None: its own); its
@@ -232,7 +230,7 @@ fn powder_bed_stays_at_rest() {
     assert_eq!(r.final_state.bodies.len(), grains, "one body per grain");
 }
 
-/// Ejected grains (issue 17 item 6): with gravity turned upwards the whole bed
+/// Ejected grains: with gravity turned upwards the whole bed
 /// lifts off, and every grain ends more than its diameter above the bed's
 /// initial top; at rest none does.
 #[test]
@@ -248,7 +246,7 @@ fn ejected_grains_are_counted() {
     assert_eq!(rest, 0, "{rest} of {grains} ejected at rest");
 }
 
-/// Issue 17 item 4, the melting-grain check: a grain thrown into a melt at
+/// The melting-grain check: a grain thrown into a melt at
 /// 2500 K melts completely (52 particles leave one by one, F22 (37)); the melt
 /// gains the grain's mass and the momentum of melt plus grain stays within 1e-5
 /// of its start (measured 5.4e-7; 4.9e-7 with the solid–fluid viscosity, 7.0e-7
@@ -294,7 +292,7 @@ fn melting_grain_melts_conserving_mass_and_momentum() {
         MELTING_GRAIN_TOLERANCE,
     );
     // With F22 (34)'s barrier between the melt and the grain, whose reaction the
-    // body pass sums since issue 27 (without it: 3.1e-5 of |P0|, above the
+    // body pass sums (without it: 3.1e-5 of |P0|, above the
     // tolerance; with it 7.0e-7).
     run_passes(
         name,
@@ -304,7 +302,7 @@ fn melting_grain_melts_conserving_mass_and_momentum() {
     );
 }
 
-/// Issue 17 item 4, the bonding rule: melt that solidifies within 1.5 Δx of a
+/// The bonding rule: melt that solidifies within 1.5 Δx of a
 /// rigid grain bonds it into the substrate (`common::BONDING_2D`). A cold grain
 /// (1000 K) rests on a cold plate under a layer of melt at 1750 K: the melt
 /// freezes against both and the grain is bonded; from then on its particles are fixed solid (velocity 0,
@@ -344,8 +342,8 @@ fn solidifying_melt_bonds_a_grain_to_the_substrate() {
 }
 
 /// The settling check: a disc of 1.5 times the liquid's density settles midway
-/// between two walls at Faxén's Stokes terminal velocity within 5% (the issue;
-/// measured 3.1% fast at a = 5 dx, Re = 0.008; 0.014% at a = 10 dx).
+/// between two walls at Faxén's Stokes terminal velocity within 5% (measured
+/// 3.1% fast at a = 5 dx, Re = 0.008; 0.014% at a = 10 dx).
 #[test]
 fn settling_disc_reaches_faxen_terminal_velocity() {
     let c = assert_check_passes("settling_disc_2d", SETTLING_TOLERANCE);

@@ -1,4 +1,4 @@
-//! Divergence-free SPH (issue 30): the hydrostatic column holds its pressure,
+//! Divergence-free SPH: the hydrostatic column holds its pressure,
 //! the implicit viscosity gives Poiseuille's profile at 100× the explicit
 //! step, the solves stop at their tolerance, and DFSPH's keys are refused
 //! where they do not apply. Bit-match on lavapipe is in tests/bitmatch.rs.
@@ -59,10 +59,10 @@ fn hydrostatic_column_holds_its_pressure_within_2_percent() {
 /// poiseuille_dfsph_2d: the implicit viscosity (F22 (23)'s form solved by
 /// conjugate gradients) at a fixed step 100× the explicit limit 0.125 h²/ν
 /// (64 steps where the explicit one needs 6 400) within 2% of the series
-/// solution (the check's tolerance, issue 2's); measured 0.17%. Weiler et
-/// al.'s projected form (`viscosity_form = "marrone"`, J22 (17)'s) is 0.83× the
-/// Laplacian at h = Δx with the quintic (terms/marrone_viscosity.rs) and
-/// measures 18%: it is reported, not asserted to pass.
+/// solution (the check's tolerance, as on WCSPH's Poiseuille); measured 0.17%.
+/// Weiler et al.'s projected form (`viscosity_form = "marrone"`, J22 (17)'s) is
+/// 0.83× the Laplacian at h = Δx with the quintic (terms/marrone_viscosity.rs)
+/// and measures 18%: it is reported, not asserted to pass.
 #[test]
 fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
     let scene = common::scene("poiseuille_dfsph_2d");
@@ -96,7 +96,7 @@ fn implicit_viscosity_gives_poiseuille_at_100_times_the_explicit_step() {
 
 /// scenarios/spray/j22_fluent_case_2d (J22's Fluent comparison, 2D coarse):
 /// impact, mean vertical velocity through zero and stop within 15% of J22's
-/// 0.5, 1.0 and 2.0 µs (the check's tolerance, issue 30's); measured
+/// 0.5, 1.0 and 2.0 µs (the check's tolerance); measured
 /// (0.501, 0.982, 1.90 µs: 1.8%). The splat spreads (a cylinder: 3.76 D0).
 #[test]
 fn spray_droplet_impact_matches_j22_timings() {
@@ -288,10 +288,9 @@ fn dfsph_keys_are_checked() {
     );
 }
 
-/// The droplet impact of `bench accuracy` (scenarios/validation/drop_impact_3d,
-/// issue 30's "droplet impact at 1-50 m/s"): F22's steel, D = 50 µm at
-/// 50 m/s, on δ-SPH as written and on DFSPH. The wall force's peak
-/// (triangle-filtered over D/(12 V)) against the inertial-regime 0.8 ρV²D²
+/// The droplet impact of `bench accuracy` (scenarios/validation/drop_impact_3d):
+/// F22's steel, D = 50 µm at 50 m/s, on δ-SPH as written and on DFSPH. The
+/// wall force's peak (triangle-filtered over D/(12 V)) against the inertial-regime 0.8 ρV²D²
 /// within 10%, the scene's tolerance: the literature quotes the prefactor to a
 /// few percent, and the peak of a sampled particle force scatters by a few
 /// percent more. Measured at the scene's D = 16 Δx: 0.801 (δ-SPH) and 0.853
@@ -436,7 +435,7 @@ fn a_lone_pair_meeting_at_the_support_edge_keeps_its_speed() {
 /// 2 µs within the scene's 10% of J22's 2.00 (measured 1.955, 2.2%). This is
 /// the spread that converges to J22's figure (2.084 and 2.059 at D0/Δx = 20
 /// and 25); the 45 and 62 µm spreads stay FAIL at every resolution run (their
-/// headers give the figures and the cause), so only this one is held here.
+/// figures and the cause are in docs/validation.md), so only this one is held here.
 /// The transient sheet's D_max/D0 is printed beside 0.5 Re^0.25 (2.725 against
 /// 2.307).
 #[test]

@@ -14,13 +14,13 @@ use spatter::state::{State, H_RATE, RAYS_ABSORBED, RAYS_AT_LIMIT, RAYS_INCIDENT,
 const N: f64 = 2.88;
 const K: f64 = 5.26;
 
-/// A flat plate absorbs the normal-incidence Fresnel value within 1% (the
-/// issue's tolerance): every ray meets the surface once, where the bins'
-/// filled fraction crosses ½ and its gradient is vertical.
+/// A flat plate absorbs the normal-incidence Fresnel value within 1%: every ray
+/// meets the surface once, where the bins' filled fraction crosses ½ and its
+/// gradient is vertical.
 const FLAT_TOLERANCE: f64 = 0.01;
-/// A 90° groove: every ray meets two walls at 45° (1 − (1 − A(45°))²) within 2%
-/// (the tolerance): the walls are staircases of particles, smoothed to
-/// planes by the bins' interpolation.
+/// A 90° groove: every ray meets two walls at 45° (1 − (1 − A(45°))²) within 2%:
+/// the walls are staircases of particles, smoothed to planes by the bins'
+/// interpolation.
 const GROOVE_TOLERANCE: f64 = 0.02;
 
 struct Split {
@@ -107,6 +107,30 @@ fn flat_plate_absorbs_the_normal_incidence_fresnel_value_2d() {
     let at = t.absorbed / t.incident;
     assert!((at - exact).abs() < FLAT_TOLERANCE * exact, "{at} {exact}");
     assert_balance(&t, 2.0e4);
+}
+
+/// A run's absorbed fraction (the closing line and `--summary`'s `laser`):
+/// Σ absorbed / Σ incident over the states read back with the beam on, so the
+/// flat plate's reads Fresnel's normal value over every sample.
+#[test]
+fn a_run_reports_its_absorbed_fraction_over_the_samples() {
+    let r = common::run_path(&plate(), &["output_interval=2.5e-7"], None);
+    let s = r
+        .laser
+        .expect("a ray-traced run reports its absorbed fraction");
+    let exact = fresnel_absorptivity(N, K, 1.0);
+    assert!(s.samples >= 4, "{} samples", s.samples);
+    assert!(
+        (s.absorbed_fraction - exact).abs() < FLAT_TOLERANCE * exact,
+        "{} {exact}",
+        s.absorbed_fraction
+    );
+    assert!(s.fraction_min <= s.absorbed_fraction && s.absorbed_fraction <= s.fraction_max);
+    assert!(
+        (s.incident_mean - 2.0e4).abs() < 1e-6 * 2.0e4,
+        "{}",
+        s.incident_mean
+    );
 }
 
 /// The same plate in 3D (a 300 × 300 µm patch at Δx = 10 µm, beam r_w = 50 µm).

@@ -1,4 +1,4 @@
-//! Resolution sweeps must not depend on rounding (issue 15, item 5). A domain
+//! Resolution sweeps must not depend on rounding. A domain
 //! extent within 1e-6 spacings of a whole number fills that many rows; any other
 //! extent, and a box face that sits on a row of lattice sites, is reported naming
 //! the key, the axis and the gap.
@@ -45,7 +45,7 @@ fn a_spacing_written_to_eight_digits_fills_every_row() {
     assert_eq!(liquid_count(&l), 18 * 30);
 }
 
-/// The issue's case: an extent of 30 Δx (1 − 1e-8) fills 30 rows.
+/// The case that once filled 29: an extent of 30 Δx (1 − 1e-8) fills 30 rows.
 #[test]
 fn an_extent_a_hair_under_thirty_spacings_fills_thirty_rows() {
     let dx = 5.0e-5;

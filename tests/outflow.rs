@@ -1,4 +1,4 @@
-//! Issue 18: particles that leave through an open side are taken out, counted and
+//! Particles that leave through an open side are taken out, counted and
 //! recorded, with the mass balance exact; the "stop" policy ends the run instead.
 //! Walls hold splashes with the F22 (34) barrier.
 
@@ -205,7 +205,7 @@ fn resume_across_removals_is_bit_identical_on_the_software_adapter() {
     resume_across_removals("gpu");
 }
 
-/// The issue's own check: the 3D dam break run on to t = 1 s (the scene ends at
+/// The 3D dam break run on to t = 1 s (the scene ends at
 /// 0.18 s) completes. Splashes leave through the open top (54 of 15 296 particles,
 /// all through z_max) and the mass balance is exact; the wall barrier keeps the
 /// sloshing out of the walls (deepest penetration 0.51 Δx; without it a particle

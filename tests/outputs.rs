@@ -1,4 +1,4 @@
-//! Run outputs (issue 3): MCAP and VTK decoded by the Python reader, endings by
+//! Run outputs: MCAP and VTK decoded by the Python reader, endings by
 //! signal and by instability, checkpoint/resume bit-identity, `spatter inspect`.
 
 mod common;
@@ -381,7 +381,7 @@ fn unstable_run_stops_with_exit_3_and_a_readable_mcap() {
     assert_eq!(ins.status.code(), Some(0));
 }
 
-/// Issue 29: a drop that disperses into its gas does not end with exit 0 in
+/// A drop that disperses into its gas does not end with exit 0 in
 /// silence. square_drop_2d at density ratio 100, its viscosities cut to 5e-3 /
 /// 5e-5 Pa s and no interface viscosity: by t = 0.284 s 14 of its 256 particles
 /// are alone in the gas. The watchdog stops it (exit 3, naming the share);
@@ -479,7 +479,7 @@ fn a_damaged_checkpoint_is_refused_with_its_name() {
 }
 
 /// A heat scene's frames carry temperature, liquid fraction and enthalpy, and its
-/// diagnostics the heat figures (issue 4).
+/// diagnostics the heat figures.
 #[test]
 fn heat_fields_and_diagnostics_reach_the_mcap() {
     let dir = scratch("outputs_heat");
@@ -604,7 +604,7 @@ fn instability_after_the_last_scan_still_stops_the_run() {
     );
 }
 
-/// Issue 18, item 2: by default a leak into the wall layers is measured and warned
+/// By default a leak into the wall layers is measured and warned
 /// about, and only a fluid particle through all the layers stops the run. The
 /// coarse 3D dam break leaks 0.54 Δx into the floor at t = 0.125 s (a warning) and
 /// particle 445 comes out under the third layer at step 411.

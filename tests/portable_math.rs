@@ -40,7 +40,8 @@ fn portable_math_bit_identical_on_software_adapter() {
     let px: Vec<f32> = (0..n).map(|_| 50.0 * lcg(&mut seed) + 1e-3).collect();
     let py: Vec<f32> = (0..n).map(|_| -20.0 + 40.0 * lcg(&mut seed)).collect();
     let zero = vec![0.0f32; n];
-    let cases: [(&str, &[f32], &[f32], fn(f32, f32) -> f32); 3] = [
+    type Case<'a> = (&'a str, &'a [f32], &'a [f32], fn(f32, f32) -> f32);
+    let cases: [Case; 3] = [
         ("pm_exp(a)", &xs, &zero, |a, _| pm::exp(a)),
         ("pm_ln(a)", &ls, &zero, |a, _| pm::ln(a)),
         ("pm_pow(a, b)", &px, &py, |a, b| pm::pow(a, b)),

@@ -1,4 +1,4 @@
-//! Issue 17 item 5: the powder-bed generator (`[powder]`, src/powder.rs) as a
+//! The powder-bed generator (`[powder]`, src/powder.rs) as a
 //! scene sees it. The generator's own checks (diameters against the truncated
 //! log-normal, no overlaps, every grain carried, the 3D packing fraction in
 //! 0.5–0.65, determinism) are unit tests in src/powder.rs.

@@ -1,6 +1,6 @@
-//! Process scenes (issue 31) that are too long for CI to run: each validates
+//! Process scenes that are too long for CI to run: each validates
 //! (exit 0, its check named), and its check's keys exit 2 when missing. Their
-//! measured figures are in their headers and docs/validation.md.
+//! measured figures are in docs/validation.md (and docs/history.md).
 
 mod common;
 
@@ -22,9 +22,9 @@ fn material_jetting_scenes_validate_and_need_their_reference_depth() {
     }
 }
 
-/// J22 §4.2's three spreads on a meltable 440C substrate (issue 30; the 30 µm
+/// J22 §4.2's three spreads on a meltable 440C substrate (the 30 µm
 /// coarse run is held in CI, tests/dfsph.rs; the 45 and 62 µm ones are run by
-/// hand: their headers give the figures).
+/// hand: docs/validation.md gives the figures).
 /// Each validates with the droplet and the substrate as liquid phases, and the
 /// splat check compares the splat's D/D0 at 2 µs with J22's value for its
 /// diameter (J22 measured its splats after 2 µs, Fig. 11).
@@ -64,8 +64,8 @@ fn spread_scenes_validate_with_j22_spread_factors() {
     common::assert_input_error(&["validate", &path.to_string_lossy()], "check.phase");
 }
 
-/// F22 §4.3's two and three drops on a 500 K substrate (issue 31; run by hand,
-/// figures in the headers): each validates with its drops, and the
+/// F22 §4.3's two and three drops on a 500 K substrate (run by hand,
+/// figures in docs/validation.md): each validates with its drops, and the
 /// drop_contact check's keys exit 2.
 #[test]
 fn drop_contact_scenes_validate() {
@@ -170,7 +170,7 @@ fn point_melt_coarse_meets_f22s_observables_and_writes_them() {
 /// margin is thin and the ejection has moved with the surface's treatment:
 /// before the free-surface tension skipped particles inside the liquid none
 /// rose above 0.36 diameters, without F22's interface viscosity one did, with
-/// F22's 7.2 unscaled two (the scene's header). F22 drives it partly with the
+/// F22's 7.2 unscaled two (docs/history.md). F22 drives it partly with the
 /// gas flow a gas-free slice has not.
 #[test]
 fn point_melt_coarse_ejects_a_grain() {
@@ -180,8 +180,8 @@ fn point_melt_coarse_ejects_a_grain() {
     assert!(c.pass, "{}", c.line());
 }
 
-/// F22 §4.4's directed energy deposition (issue 31; 2 to 3 minutes each on 2
-/// cores, so run by hand: figures in the headers). Each coarse scene and the
+/// F22 §4.4's directed energy deposition (2 to 3 minutes each on 2
+/// cores, so run by hand: figures in docs/validation.md). Each coarse scene and the
 /// full-size one validate with their five grains, the full size states its
 /// cost, and the deposition check's keys exit 2.
 #[test]
@@ -224,8 +224,8 @@ fn deposition_scenes_validate_and_their_check_keys_exit_2() {
     );
 }
 
-/// F22 §4.2's binder jetting at 1, 10 and 50 m/s (issue 31; 1 to 3 minutes
-/// each on 2 cores, so run by hand: figures in the headers). Each validates
+/// F22 §4.2's binder jetting at 1, 10 and 50 m/s (1 to 3 minutes
+/// each on 2 cores, so run by hand: figures in docs/validation.md). Each validates
 /// with its drop speed and gas, the 10 m/s scene's order references are the
 /// 1 m/s scene's, and the binder check's keys exit 2.
 #[test]

@@ -1,4 +1,4 @@
-//! R18 §5.1.1's 2D powder-bed track power study (issue 28, Table 5.3): the
+//! R18 §5.1.1's 2D powder-bed track power study (R18 Table 5.3): the
 //! scene `scenarios/pbf/r18_track_2d.toml` swept over R18's 50, 100, 150 and
 //! 200 W (P / 54 µm per metre of depth), each run to R18's t = 0.26 ms on the
 //! coarse 8 µm lattice (3 690 particles, about 15 s a run). The `r18_track`

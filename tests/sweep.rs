@@ -1,4 +1,4 @@
-//! Process maps (issue 29 item 3): `spatter sweep` runs a grid of overrides,
+//! Process maps: `spatter sweep` runs a grid of overrides,
 //! skips finished cells on a rerun, writes a Slurm job array whose per-task
 //! command runs one cell, and `sweep collect` gathers the runs into a CSV and a
 //! map. On the README's 2D line melt cut to 30 µs (a few seconds a run).

@@ -1,4 +1,4 @@
-//! Issue 16: surface tension (CSF, F22 (24)–(26)) with gas particles. Each
+//! Surface tension (CSF, F22 (24)–(26)) with gas particles. Each
 //! check's tolerance is stated and justified here and must be its scene file's;
 //! a test that holds a check to what the method gives today states that bound
 //! apart.
@@ -7,23 +7,21 @@ mod common;
 use common::{assert_stated_tolerance, figure, print_check, run_check, scene, spatter, text};
 use spatter::checks::CheckResult;
 
-/// The Laplace pressure of the disc in gas: the issue's 3% at R = 20Δx (F22's
+/// The Laplace pressure of the disc in gas: the target 3% at R = 20Δx (F22's
 /// form). Not met today (the ignored test says why).
 const LAPLACE_TOLERANCE: f64 = 0.03;
-/// The free-surface form (no gas): the issue's 5% at R = 20Δx. Not met today.
+/// The free-surface form (no gas): the target 5% at R = 20Δx. Not met today.
 const FREE_SURFACE_LAPLACE_TOLERANCE: f64 = 0.05;
-/// The 3D sphere in gas: the issue's 5% at R = 10Δx. Not met today.
+/// The 3D sphere in gas: the target 5% at R = 10Δx. Not met today.
 const LAPLACE_SPHERE_TOLERANCE: f64 = 0.05;
-/// The recoil momentum balance: the momentum gained within 2% of −∫ p_v A dt
-/// (the issue).
+/// The recoil momentum balance: the momentum gained within 2% of −∫ p_v A dt.
 const RECOIL_TOLERANCE: f64 = 0.02;
-/// A square drop relaxed to a disc: the outline's radius spread below 0.5Δx
-/// (the issue).
+/// A square drop relaxed to a disc: the outline's radius spread below 0.5Δx.
 const DROP_SHAPE_TOLERANCE: f64 = 0.5;
-/// Sessile drops: the contact angle within 5° of the static one (the issue).
+/// Sessile drops: the contact angle within 5° of the static one.
 const CONTACT_ANGLE_TOLERANCE: f64 = 5.0;
 /// The thermocapillary channel: the interface velocity within 5% of the
-/// analytic amplitude at the finest resolution (the issue).
+/// analytic amplitude at the finest resolution.
 const THERMOCAPILLARY_TOLERANCE: f64 = 0.05;
 /// Spurious currents, as the capillary number η|u|/σ: below 0.1 in every scene
 /// at rest (measured 2e-2 to 6.5e-2).
@@ -33,16 +31,17 @@ fn run_laplace(sets: &[&str]) -> CheckResult {
     run_check("laplace_disc_2d", sets)
 }
 
-/// The issue's reference: Δp within 3% of σ/R at R = 20Δx (F22's form with gas).
+/// The target: Δp within 3% of σ/R at R = 20Δx (F22's form with gas).
 /// Not met: +12.4%, +9.3%, +11.4% at R = 10, 20, 40Δx with F22's background
 /// pressure 5p0 (−11% at 20Δx without it, where a gap opens between the phases
 /// and the surface delta integrates to 0.91): a bias of about 10% that does not
 /// fall with Δx. At 20Δx the force's row (the first liquid row, the only one with
 /// normals at density ratio 10) has Σ V δ = 1.04 per unit length of the circle
-/// and mean curvature 1.05/R. Kept at the issue's tolerance; see the
-/// evidence-based test below and the note on issue 16.
+/// and mean curvature 1.05/R. Kept at the target tolerance; see the
+/// evidence-based test below and docs/validation.md ("Surface tension and
+/// wetting").
 #[test]
-#[ignore = "Laplace pressure +9.3% at R = 20 dx, +11.4% at 40 dx (issue asks 3%): a ~10% bias from the one-row normals and curvature; see the note on issue 16"]
+#[ignore = "Laplace pressure +9.3% at R = 20 dx, +11.4% at 40 dx (target 3%): a ~10% bias from the one-row normals and curvature; see docs/validation.md"]
 fn laplace_pressure_within_3_percent_at_20_dx() {
     assert_stated_tolerance(&scene("laplace_disc_2d"), LAPLACE_TOLERANCE);
     let c = run_laplace(&[]);
@@ -52,7 +51,7 @@ fn laplace_pressure_within_3_percent_at_20_dx() {
 /// What the method gives today, at the coarsest resolution (R = 10Δx, 14 s):
 /// +12.4% measured; the bound 15% leaves room for the machine's rounding order
 /// only. Spurious currents: capillary number η|u|/σ measured 6.5e-2 at R = 10Δx
-/// and 4.8e-2 at 20Δx (falling with resolution, as the issue asks); bound 0.1.
+/// and 4.8e-2 at 20Δx (falling with resolution, as it should); bound 0.1.
 #[test]
 fn laplace_pressure_at_10_dx_as_measured() {
     let c = run_laplace(&["dx=2e-3"]);
@@ -164,14 +163,14 @@ fn a_free_surface_on_disordered_particles_is_warned_about() {
     }
 }
 
-/// Issue 28: the free-surface Laplace disc (R = 20Δx, no gas) on R18's δ-SPH,
+/// The free-surface Laplace disc (R = 20Δx, no gas) on R18's δ-SPH,
 /// the scene's formulation, without a pressure floor: −4.6% measured (5% asked;
 /// +13.2% at 10Δx, +3.8% at 40Δx). On summation density the
 /// same disc gave +211 / +285 / +764% at R = 10, 20, 40Δx: the surface row's
 /// density is short (737 kg/m³ at t = 0), the pressure floor leaves it at p = 0
 /// and it compacts from 56 particles at 1.00Δx to 92 at 0.49Δx, buckling at the
 /// particle scale. R18's own Young–Laplace run measured 6 against the 2D
-/// σ/R = 10 (−40%; PAPERS-EXTRACT §7.2 row 14).
+/// σ/R = 10 (−40%; R18 §4.2).
 #[test]
 fn free_surface_laplace_within_5_percent_at_20_dx() {
     let name = "laplace_free_disc_2d";
@@ -485,11 +484,12 @@ fn solid_fluid_viscosity_input_and_limit() {
     );
 }
 
-/// A square drop in gas relaxes to a disc (issue 16): the outline's radius
-/// spread over its sectors below 0.5Δx (the issue's bound; measured 0.14Δx at
+/// A square drop in gas relaxes to a disc: the outline's radius
+/// spread over its sectors below 0.5Δx (the target; measured 0.14Δx at
 /// R = 9Δx, from 3.3Δx at the start) and spurious currents with capillary number
 /// below 0.1 (measured 4.4e-2; 4.8e-2 and 5.5e-2 at R = 4.5 and 16.9Δx: not
-/// falling with Δx, as the issue asks; see the note on issue 16).
+/// falling with Δx, as it should; see docs/validation.md, "Surface tension and
+/// wetting").
 #[test]
 fn square_drop_relaxes_to_a_disc() {
     let c = common::assert_check_passes("square_drop_2d", DROP_SHAPE_TOLERANCE);
@@ -500,10 +500,10 @@ fn square_drop_relaxes_to_a_disc() {
     );
 }
 
-/// The 3D sphere in gas: Δp within 5% of 2σ/R at R = 10Δx (the issue). Measured
+/// The 3D sphere in gas: Δp within 5% of 2σ/R at R = 10Δx (the target). Measured
 /// +11.3% (24 min on 2 cores): the ~10% bias of the 2D disc. Too long for CI.
 #[test]
-#[ignore = "24 min on 2 cores; measured +11.3% at R = 10 dx (issue asks 5%), the 2D disc's ~10% bias; see the note on issue 16"]
+#[ignore = "24 min on 2 cores; measured +11.3% at R = 10 dx (target 5%), the 2D disc's ~10% bias; see docs/validation.md"]
 fn laplace_sphere_3d_within_5_percent_at_10_dx() {
     common::assert_check_passes("laplace_sphere_3d", LAPLACE_SPHERE_TOLERANCE);
 }
@@ -515,7 +515,7 @@ fn contact_angle(sets: &[&str]) -> CheckResult {
     run_check("sessile_drop_2d", sets)
 }
 
-/// Sessile drops settle at their static contact angle within 5° (the issue),
+/// Sessile drops settle at their static contact angle within 5° (the target),
 /// at R ≈ 10Δx: 90° measured 86.2° (1.5 s), 60° measured 63.3° (3 s: it spreads
 /// slowly).
 #[test]
@@ -649,9 +649,10 @@ fn a_low_viscosity_free_disc_holds_only_with_the_interface_viscosity() {
 /// 120° within 5°: not met at R ≈ 10Δx, measured 106.6° after 3 s (109.3° at
 /// 1.5 s): the drop beads up but stops short, a bias towards 90° that the 60°
 /// and 90° drops show too (63.3°, 85.4°). At Δx = 1 mm (R ≈ 20Δx, 2 s, 7 min)
-/// 113.7°: the gap halves with Δx. See the note on issue 16.
+/// 113.7°: the gap halves with Δx. See docs/validation.md ("Surface tension and
+/// wetting").
 #[test]
-#[ignore = "contact angle 106.6 deg for 120 (issue asks within 5 deg) at R = 10 dx; see the note on issue 16"]
+#[ignore = "contact angle 106.6 deg for 120 (target within 5 deg) at R = 10 dx; see docs/validation.md"]
 fn sessile_drop_at_120_degrees_within_5() {
     let c = contact_angle(&["surface_tension.contact_angle=120.0", "end_time=3.0"]);
     assert!(c.value <= CONTACT_ANGLE_TOLERANCE, "{}", c.line());
@@ -659,12 +660,12 @@ fn sessile_drop_at_120_degrees_within_5() {
 
 /// Thermocapillary channel (Pendse & Esmaeeli 2010, scenarios/validation/
 /// thermocapillary_2d.toml): the interface velocity profile (20 points per
-/// wavelength) within 5% of the analytic amplitude, the issue's tolerance, at
+/// wavelength) within 5% of the analytic amplitude, the target tolerance, at
 /// a = 20Δx, and the error falling from a = 10Δx. Measured 8.97% / 4.49% /
 /// 2.78% at a = 10 / 20 / 40Δx (8 s, 61 s, 33 min on 2 cores): first order, the
 /// Marangoni stress acting over the liquid side's surface delta (liquid rows
 /// +27.6% / +14.4% / +7.2% fast, the second fluid's first row −15.5% / −6.2% /
-/// −2.4% slow). The issue asks the tolerance at the finest of three resolutions
+/// −2.4% slow). The target applies at the finest of three resolutions
 /// (met at 40Δx, too long for CI); `spatter bench accuracy --scenes
 /// thermocapillary_2d` runs all three.
 #[test]
@@ -753,7 +754,7 @@ fn contact_angle_per_phase() {
     }
 }
 
-/// Issue 29: `validate` warns on surface tension with gas at a density ratio of
+/// `validate` warns on surface tension with gas at a density ratio of
 /// 10 or more without F22's interface viscosity, naming F22's values; with it
 /// set, no such warning.
 #[test]

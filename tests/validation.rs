@@ -7,16 +7,16 @@ use common::{assert_check_passes, assert_stated_tolerance, run_check, scene};
 use spatter::run::load;
 
 /// Poiseuille and Couette start-up flows: relative L2 error of the velocity
-/// profile against the series solution, 2% (issue 2).
+/// profile against the series solution, 2%.
 const PROFILE_TOLERANCE: f64 = 0.02;
 /// Hydrostatic columns: RMS error of the pressure deeper than one kernel support
-/// below the surface, relative to ρ g H, 2% (issue 2).
+/// below the surface, relative to ρ g H, 2%.
 const HYDROSTATIC_TOLERANCE: f64 = 0.02;
 /// Liquid under gas: the pressure jump across the interface relative to the
-/// liquid head ρ_l g H_l, 5% (issue 2); a particle across the interface fails
+/// liquid head ρ_l g H_l, 5%; a particle across the interface fails
 /// the check outright.
 const TWO_LAYER_TOLERANCE: f64 = 0.05;
-/// The surge front against the experiments: within 10% (issue 2).
+/// The surge front against the experiments: within 10%.
 const FRONT_TOLERANCE: f64 = 0.10;
 /// The compression check against g d / c² at the deepest particle: 5%, the
 /// start-up acoustic overshoot of the 0.3 s run (measured +2.9%).
@@ -95,7 +95,7 @@ fn hydrostatic_start_stacks_the_layers() {
     assert_eq!(layers_seen, [true; 2], "both layers are stacked");
 }
 
-/// Density ratio 1000, issue 2's upper bound, without the interface viscosity:
+/// Density ratio 1000, without the interface viscosity:
 /// two_layer_2d with an air-like gas (ρ = 1 kg/m³, c = 316 m/s at the same p0).
 /// With the hydrostatic start no particle crosses the interface: the lowest
 /// own-phase colour is 0.669 (threshold ½). The interface need not stay level
@@ -147,10 +147,11 @@ fn two_layer_ratio_1000_with_interface_viscosity_within_5_percent() {
 /// 19.1% at T = 1.19 (the front is one particle, so rounding moves it by about a
 /// point: 19.3% before the wall pass's weight floor, 19.9% on an H100). Refining
 /// dx 5 → 2.5 → 1.25 mm gave 18.7 → 19.3 → 20.9%, so it is not discretisation
-/// error (note on issue 2). DualSPHysics' own validation case runs as far ahead
-/// of the same experiment (README, Validation), and with one fitted release
-/// delay the front is within 10% of both experiments (the tests below). Kept at
-/// the issue's 10% tolerance rather than widened; run with `--ignored` to see it.
+/// error (docs/validation.md, "Dam break: the surge front"). DualSPHysics' own
+/// validation case runs as far ahead of the same experiment (README,
+/// Validation), and with one fitted release delay the front is within 10% of
+/// both experiments (the tests below). Kept at the target 10% tolerance rather
+/// than widened; run with `--ignored` to see it.
 #[test]
 #[ignore = "surge front 20.4% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
 fn dam_break_front_within_10_percent() {
@@ -163,7 +164,7 @@ fn dam_break_front_within_10_percent() {
 /// gate lifted at constant speed does not explain it: README, dam_break_gate_2d).
 /// So the experiment's clock gets one fitted start delay ΔT in
 /// (0, 0.5) of T (up to 43 / 27 ms in their columns), and the front must then be
-/// within the issue's 10% of every data point with T <= 2.5. A front at the wrong
+/// within the target 10% of every data point with T <= 2.5. A front at the wrong
 /// speed fails whatever the delay (unit test in checks/dam_break.rs); the unshifted criterion
 /// stays in the ignored test above. Measured on the CPU (2D, dx = 2.5 mm): K&O
 /// 7.5% at ΔT = 0.198 (17 ms), M&M 1.8% at ΔT = 0.275 (15 ms); at dx = 5 and
@@ -193,7 +194,7 @@ fn dam_break_2d_front_moves_as_in_the_experiments_after_the_release() {
 /// The dam break on δ-SPH (no pressure floor, R18's free surface): the front
 /// leads Koshizuka & Oka by 19.8% at T = 2.45 and Martin & Moyce by 18.3%
 /// (summation density: 20.4% / 19.1%), so the lead is not the formulation's;
-/// fails the issue's 10% for the same reason as the test above.
+/// fails the target 10% for the same reason as the test above.
 #[test]
 #[ignore = "δ-SPH surge front 19.8% ahead of Koshizuka & Oka at T = 2.45 (tolerance 10%)"]
 fn dam_break_front_within_10_percent_on_delta_sph() {
@@ -396,7 +397,7 @@ fn peer_bench_scene_has_the_peer_particle_count() {
     assert!(out.contains(&peer), "{out}");
 }
 
-/// Issue 29: every `--set` a scene header recommends is accepted by the scene
+/// Every `--set` a scene header recommends is accepted by the scene
 /// (`validate`, exit 0): a documented override that ends in exit 2 is a defect.
 /// Each is tried alone, read from the header's comments (quoted or bare, across
 /// a line break), in every folder under `scenarios/`.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One prepared command for a lent GPU (issue 32): the hardware-vs-reference
+# One prepared command for a lent GPU: the hardware-vs-reference
 # tolerance check on scenes that together run every pass and term, then the
 # GPU throughput of plain WCSPH and of the PBF scenes, with per-pass times.
 # Results under $OUT: compare.log, throughput_wcsph.json, throughput_pbf.json,
@@ -8,7 +8,8 @@
 # Here, before the device call (the binary is built here and carried):
 #   cargo build --release && mkdir -p .dev && cp target/release/spatter .dev/
 #   (.gitignore lists /.dev/ and /.gl/: they travel only as `carry`)
-#   (the Vulkan loader, once: /work/.library/device/README.md, into .gl/)
+#   (the Vulkan loader libvulkan.so.1, once, into .gl/: the device machine has the
+#   NVIDIA driver but may lack the loader)
 # The device call (run, carry [".dev", ".gl"], timeout_s 600):
 #   bash tools/device_check.sh
 # Rehearsal here on lavapipe, small sizes, in a couple of minutes:

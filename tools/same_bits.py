@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Same-bits check for refactors (issues 14, 27): run a spatter binary on fourteen scenes for
+"""Same-bits check for refactors: run a spatter binary on fourteen scenes for
 200 steps on the CPU and on the GPU backend (lavapipe here), and compare the
 checkpoint each run writes at its end with a stored reference.
 
@@ -9,12 +9,13 @@ What is compared is the checkpoint's body: every particle array and the Sim bloc
 byte for byte (SHA-256). The JSON header is left out because it names the backend
 ("cpu (2 threads)", the adapter and driver), which differs between machines while
 the state must not. The stored hashes (tools/same_bits.ref) were written by the
-last commit before the issue-14 redesign (3003071) on this project's 2-core
-machine with Mesa lavapipe; `--write` replaces them. poiseuille_2d and couette_2d
-were rewritten when the periodic cell count stopped depending on rounding (4 cells
-across their period instead of 3: the neighbour order, and so the last bits, changed;
-CPU and GPU still agree); melt_block_3d and melting_grain_2d when the
-solidification record (issue 29) joined the checkpoints of melting scenes (every
+last commit (3003071) before the redesign into a typed parameter block, a pass
+table and WGSL libraries, on this project's 2-core machine with Mesa lavapipe;
+`--write` replaces them. poiseuille_2d and couette_2d were rewritten when the
+periodic cell count stopped depending on rounding (4 cells across their period
+instead of 3: the neighbour order, and so the last bits, changed; CPU and GPU
+still agree); melt_block_3d and melting_grain_2d when the
+solidification record joined the checkpoints of melting scenes (every
 array they had before compared equal after 200 steps, frame by frame, against the
 binary of the commit before it, 68d391c). Exit 0 when every hash
 matches, 1 otherwise. Not part of CI (about a minute on 2 cores).
@@ -31,7 +32,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REF = os.path.join(ROOT, "tools", "same_bits.ref")
 STEPS = 200
 
-# (label, scenario, --set overrides): the six scenes issue 14 names, then issue 27's.
+# (label, scenario, --set overrides): the six scenes the parameter-block redesign
+# was checked on, then those added before the schedule refactor, then δ-SPH's.
 TRANSLATING_LID = [
     "phases.lid.moves=true",
     "phases.lid.velocity=[2.5e-3, 0.0]",
@@ -48,19 +50,20 @@ SCENES = [
     ("melt_block_3d", "melt_block_3d", []),
     ("laser_plate_under_gas_2d", "laser_plate_under_gas_2d", []),
     ("couette_2d_translating_lid", "couette_2d", TRANSLATING_LID),
-    # Issue 27 (written by d80fdc6, before the schedule refactor): surface tension
+    # Added for the schedule refactor (written by d80fdc6, before it): surface tension
     # in both forms (wetting with gas; the free surface), rigid bodies (in a
     # walled liquid; melting in melt; free rotation in 3D) and the wall barrier
     # acting from the first step.
     ("sessile_drop_2d", "sessile_drop_2d", []),
-    # The scene runs δ-SPH since issue 28; its reference is summation density's.
+    # The scene runs δ-SPH since that formulation landed; its reference is summation
+    # density's.
     ("laplace_free_disc_2d", "laplace_free_disc_2d",
      ['simulation.formulation="wcsph"', "simulation.pressure_floor=true"]),
     ("settling_disc_2d", "settling_disc_2d", []),
     ("melting_grain_2d", "melting_grain_2d", []),
     ("free_rotation_3d", "free_rotation_3d", []),
     ("dam_break_2d_barrier", "dam_break_2d", BARRIER),
-    # δ-SPH (issue 28), written when it landed.
+    # δ-SPH, written when it landed.
     ("laplace_free_disc_2d_delta", "laplace_free_disc_2d", []),
     ("dam_break_3d_delta", "dam_break_3d", ['simulation.formulation="delta_wcsph"']),
 ]

@@ -10,12 +10,12 @@ fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 }
 
 // Particles still in the simulation: the removed ones sit after them, sorted
-// last by the neighbour pass (issue 18); every other pass stops here.
+// last by the neighbour pass; every other pass stops here.
 fn active_particles() -> u32 {
     return P.sizes.n_particles - sim.removed;
 }
 
-// Outside the box a particle must stay in (issue 18): it has left.
+// Outside the box a particle must stay in: it has left.
 fn outside_keep_box(p: vec4<f32>) -> bool {
     let lo = P.grid.keep_lo;
     let hi = P.grid.keep_hi;

@@ -15,7 +15,7 @@ struct Grid {
     cell_inv: vec4<f32>,     // 1 / cell size per axis
     period: vec4<f32>,       // period length per axis (0 where not periodic)
     half_period: vec4<f32>,
-    keep_lo: vec4<f32>,      // below keep_lo or above keep_hi: left (issue 18)
+    keep_lo: vec4<f32>,      // below keep_lo or above keep_hi: left
     keep_hi: vec4<f32>,
 }
 
@@ -262,7 +262,7 @@ struct Sim {
     dt_limit: u32,
     umax2: f32,
     amax2: f32,
-    removed: u32,            // particles taken out, sorted last (issue 18)
+    removed: u32,            // particles taken out, sorted last
     end_time: f32,           // the run's end (0: none); the last steps land on it
 }
 

@@ -14,29 +14,7 @@
 use super::passes::{Features, Stage};
 use crate::params::Params;
 use crate::scene::Formulation;
-
-/// Solver slots: one `Solver` entry (iterations, converged flag, residual) per
-/// repeat a scene's schedule can hold, in `State::solvers` and the `solvers`
-/// buffer. The WGSL names the same slots (`SOLVER_*` in shaders/lib/params.wgsl).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SolverSlot {
-    /// R18 Algorithm 3.1: the trapezoidal heat iteration.
-    Heat = 0,
-    /// DFSPH's constant-density solve.
-    Density = 1,
-    /// DFSPH's divergence-free solve.
-    Divergence = 2,
-    /// DFSPH's implicit viscosity (conjugate gradients).
-    Viscosity = 3,
-}
-
-/// Solver slots in the `solvers` buffer (every scene with a repeat holds them all).
-pub const SOLVER_SLOTS: [(SolverSlot, &str); 4] = [
-    (SolverSlot::Heat, "heat"),
-    (SolverSlot::Density, "dfsph_density"),
-    (SolverSlot::Divergence, "dfsph_divergence"),
-    (SolverSlot::Viscosity, "dfsph_viscosity"),
-];
+pub use crate::state::{SolverSlot, SOLVER_SLOTS};
 
 /// A bounded repeat: `begin` once (it resets its solver's slot), then up to
 /// `max_iterations` rounds of `stages`, the last of which sets the converged flag.
@@ -80,8 +58,11 @@ impl Node {
 /// accelerations, temperatures and Δt).
 pub struct FormulationDef {
     pub formulation: Formulation,
-    pub schedule: fn(&Features, &Params) -> (Vec<Node>, Vec<Node>),
+    pub schedule: ScheduleFn,
 }
+
+/// Lists a formulation's nodes for a scene's features: (step, prime).
+pub type ScheduleFn = fn(&Features, &Params) -> (Vec<Node>, Vec<Node>);
 
 pub const FORMULATIONS: [FormulationDef; 3] = [
     FormulationDef {
@@ -264,7 +245,7 @@ pub fn formulation(f: Formulation) -> &'static FormulationDef {
         .expect("every formulation has a row in FORMULATIONS")
 }
 
-/// What a scene runs: its features and its formulation's schedule (DESIGN.md:
+/// What a scene runs: its features and its formulation's schedule (docs/design.md:
 /// only what its physics needs; a scene without wall particles has no wall
 /// pass, a scene without temperature no heat pass and no heat buffers).
 #[derive(Debug, Clone, PartialEq, Eq)]

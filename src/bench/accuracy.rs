@@ -649,7 +649,7 @@ pub fn accuracy(opts: &Options) -> Result<(), SpatterError> {
     Ok(())
 }
 
-/// Issue 28 item 3: every resolution at which a scene ran both as written and as
+/// Every resolution at which a scene ran both as written and as
 /// an `@variant` (another formulation), the two errors and wall times on one
 /// line, so a user sees which formulation buys its error for less time.
 fn formulation_table(runs: &[AccuracyRun]) -> Vec<String> {

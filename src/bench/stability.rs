@@ -204,7 +204,7 @@ pub struct CaseResult {
     /// (M_end − M_0)/M_0 over every particle, those in the domain and those that
     /// left (exact sums of the f32 masses): must be exactly 0.
     pub mass_drift: f64,
-    /// Particles that left the domain through an open side (issue 18).
+    /// Particles that left the domain through an open side.
     pub removed: u64,
     /// |P_end − P_0| / Σ m|v| at the end, where the scene conserves momentum.
     pub momentum_drift: Option<f64>,
@@ -846,7 +846,7 @@ mod emptied {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/laplace_free_disc_2d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let (m, st0) = (&l.model, &l.state);
         let mut st1 = st0.clone();
         st1.sim.removed = st1.len() as u32 - 1;

@@ -467,7 +467,7 @@ fn gpu_pass_times(l: &Loaded, steps: u32) -> Vec<(String, f64)> {
 }
 
 /// Per scene and backend, how the cost of a particle-step grows from the smallest
-/// size measured to the largest (DESIGN.md asks for at most 40% from 1e4 to 1e6,
+/// size measured to the largest (docs/design.md asks for at most 40% from 1e4 to 1e6,
 /// then at most 20% on to 1e7), and why: the same cost per fluid particle-step
 /// and per fluid pair (a scaled scene keeps its walls a few layers thick, so
 /// small scenes are mostly wall, whose particles cost a fraction of a fluid

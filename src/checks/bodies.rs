@@ -1,4 +1,4 @@
-//! Rigid-body checks (issue 17): the restitution of a two-body collision against
+//! Rigid-body checks: the restitution of a two-body collision against
 //! the spring–dashpot's analytic value, and torque-free rotation (conservation
 //! of angular momentum and energy, the intermediate-axis flip).
 
@@ -551,8 +551,8 @@ mod tests {
     #[test]
     fn restitution_limits() {
         assert!((super::restitution(1.0, 0.0, 1.0) - 1.0).abs() < 1e-12);
-        let (k, m) = (1.0, 5e-4);
-        let d = 2.0 * 0.2 * (k * m as f64).sqrt();
+        let (k, m) = (1.0f64, 5e-4f64);
+        let d = 2.0 * 0.2 * (k * m).sqrt();
         let e = super::restitution(k, d, m);
         let unclipped = (-0.2 * std::f64::consts::PI / (1.0f64 - 0.04).sqrt()).exp();
         assert!(e > unclipped && e < 1.0, "{e} vs {unclipped}");

@@ -43,7 +43,7 @@ impl Check for DamBreak {
         let mut used = 0;
         for &(t, front) in &self.samples {
             let tt = t * scale;
-            // From the first data point of either experiment to T = 2.5 (issue 2).
+            // From the first data point of either experiment to T = 2.5.
             if !(table[1].0..=DAM_BREAK_T_MAX).contains(&tt) {
                 continue;
             }
@@ -91,7 +91,7 @@ impl Check for DamBreak {
     }
 }
 
-/// Latest T of the experiments' points the dam-break check compares with (issue 2).
+/// Latest T of the experiments' points the dam-break check compares with.
 const DAM_BREAK_T_MAX: f64 = 2.5;
 /// Release delays tried by the fit, in units of T: 0 to 0.5 (0 to 43 ms in Koshizuka
 /// & Oka's column, 0 to 27 ms in Martin & Moyce's) by 0.0025.

@@ -192,7 +192,7 @@ pub struct RisingAmplitude {
     swing: f64,
     rho_initial: Option<f64>,
     /// (t, interior error, band error, true density / initial, regions).
-    samples: Vec<(f64, f64, f64, f64, usize)>,
+    samples: Vec<CycleSample>,
 }
 
 impl RisingAmplitude {
@@ -307,9 +307,13 @@ impl Check for RisingAmplitude {
     }
 }
 
+/// A sample of the rising-amplitude drop: time, swing, interior error, band
+/// error, pieces.
+type CycleSample = (f64, f64, f64, f64, usize);
+
 /// One line per second of samples (a cycle of R18's program): the largest
 /// swing and the worst interior and band errors.
-fn per_cycle(samples: &[(f64, f64, f64, f64, usize)]) -> Vec<String> {
+fn per_cycle(samples: &[CycleSample]) -> Vec<String> {
     let mut lines = Vec::new();
     let end = samples.last().map_or(0.0, |s| s.0);
     let mut t0 = 0.0;
@@ -319,9 +323,8 @@ fn per_cycle(samples: &[(f64, f64, f64, f64, usize)]) -> Vec<String> {
             .filter(|s| s.0 > t0 && s.0 <= t0 + 1.0)
             .collect();
         if !part.is_empty() {
-            let worst = |f: &dyn Fn(&(f64, f64, f64, f64, usize)) -> f64| {
-                part.iter().map(|s| f(s)).fold(0.0, f64::max)
-            };
+            let worst =
+                |f: &dyn Fn(&CycleSample) -> f64| part.iter().map(|s| f(s)).fold(0.0, f64::max);
             lines.push(format!(
                 "  t in ({t0:.0}, {:.0}] s: swing {:.1}%, interior {:.2e}, band {:.2e}, pieces up to {}",
                 t0 + 1.0,

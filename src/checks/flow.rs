@@ -28,7 +28,7 @@ impl Check for Profile {
 
 /// RMS deviation from p = ρ0 g (H − z), relative to ρ0 g H, over liquid particles
 /// deeper than `exclude` below the surface (summation density is deficient within
-/// one kernel support of a free surface, PHYSICS.md §2a).
+/// one kernel support of a free surface: docs/physics.md, formulation `wcsph`).
 fn hydrostatic(m: &Model, st: &State, surface: f64, exclude: f64) -> (String, f64, Vec<String>) {
     let ax = m.dim as usize - 1;
     let rho0 = liquid_rho0(m);
@@ -57,7 +57,7 @@ pub enum Profile {
 }
 
 /// Relative L2 error of u_x(y, t) over all liquid particles against the series
-/// solutions of PHYSICS.md §9 (Morris et al. 1997), plates at y = 0 and y = L.
+/// solutions (Morris et al. 1997), plates at y = 0 and y = L.
 fn profile_error(m: &Model, st: &State, which: Profile) -> (String, f64, Vec<String>) {
     let t = st.sim.time as f64;
     let l = m.domain_hi[1] - m.domain_lo[1];

@@ -1,6 +1,6 @@
 //! The force a droplet exerts on a flat wall when it lands (3D): the
 //! accuracy benchmark of a droplet impact, the same scene on WCSPH and on
-//! DFSPH (issue 30, `bench accuracy`).
+//! DFSPH (`bench accuracy`).
 //!
 //! Without gravity the only vertical force on the droplet is the wall's, so
 //! the wall force is the rate of change of the droplet's vertical momentum:

@@ -1,4 +1,4 @@
-//! Validation checks against reference solutions (PHYSICS.md §9). A scene's `[check]`
+//! Validation checks against reference solutions (docs/validation.md). A scene's `[check]`
 //! section picks one; the run feeds it state samples and prints its verdict.
 //!
 //! One file per kind, each a `Check`: flow.rs (hydrostatic pressure, Poiseuille

@@ -1,6 +1,6 @@
 //! F22 §4.5's PBF point melting: a beam held still on a powder bed, then
 //! switched off. F22 prints no number for it, only an order of events; the
-//! check holds the run to the four the issue names (issue 31), each measured
+//! check holds the run to four observables from that order, each measured
 //! on the samples:
 //! 1. **Peak temperature above T_v**: the hottest condensed particle at any
 //!    sample against the melting material's boiling temperature

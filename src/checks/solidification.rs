@@ -1,4 +1,4 @@
-//! The solidification record (issue 29 item 2) against the two-phase Stefan
+//! The solidification record against the two-phase Stefan
 //! (Neumann) problem: a superheated melt at T_0 freezing from a wall held at
 //! T_w below its melting temperature T_m (Carslaw & Jaeger §11.2, Neumann's
 //! solution). With α_s, α_l the solid's and liquid's diffusivities and

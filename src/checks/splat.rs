@@ -1,7 +1,7 @@
-//! A droplet's impact and splat against J22's Fluent comparison (J22 §4.1,
-//! PAPERS-EXTRACT §4.7): the droplet (`phase`, or every liquid phase) falls
-//! along the last axis (y in 2D, z in 3D) onto the substrate: the domain's
-//! lower face, or the top of a liquid or solid substrate under it (J22 §4.2).
+//! A droplet's impact and splat against J22's Fluent comparison (J22 §4.1):
+//! the droplet (`phase`, or every liquid phase) falls along the last axis (y in
+//! 2D, z in 3D) onto the substrate: the domain's lower face, or the top of a
+//! liquid or solid substrate under it (J22 §4.2).
 //! From every sample:
 //! - the gap between the droplet's lowest particle and the substrate face
 //!   (less Δx/2); the impact is where it reaches zero, by linear

@@ -1,4 +1,4 @@
-//! Surface-tension checks (issue 16).
+//! Surface-tension checks.
 
 use super::{particles, Check, Verdict};
 use crate::model::Model;

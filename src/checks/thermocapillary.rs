@@ -226,7 +226,7 @@ pub fn channel(m: &Model, surface: f64) -> Channel {
 /// profile at 20 points whatever Δx, so that the figure compares across
 /// resolutions; single particles carry the flow's noise, and the rows shear by
 /// about a Δx along x over the run), the largest bin's |mean residual| over the
-/// interface speed's amplitude U (the "within 5% of its maximum"). Taken
+/// interface speed's amplitude U (the tolerance is a share of that maximum). Taken
 /// at the last sample (steady state). Reported beside it: each side's amplitude
 /// against the analytic one at the same particles, and the change of the band's
 /// fitted amplitude over the run's last quarter (steadiness).

@@ -94,7 +94,7 @@ struct Crossing {
 ///   c_i = Σ_{j of i's phase} V_j W_ij / Σ_{j fluid} V_j W_ij,  V_j = m_j/ρ_j.
 /// The interface is where the colour function is ½ (the F22 (19) normal is its
 /// gradient), so c_i < ½ means particle i sits on the other phase's side. This
-/// asks what issue 2 asks, whether a particle crossed, and not whether the
+/// asks what the check is for, whether a particle crossed, and not whether the
 /// interface stays flat: a meniscus at a wall can lift the liquid's top above
 /// the gas's bottom a few particles away, yet every particle stays on its own
 /// side (tests/validation.rs, two_layer_ratio_1000_no_crossing). Walls do not count, so a corner particle's

@@ -1,4 +1,4 @@
-//! Heat figures of a `/diagnostics` record (issue 4): the hottest particle, the
+//! Heat figures of a `/diagnostics` record: the hottest particle, the
 //! enthalpy, the laser's absorbed power, the losses through free surfaces and the
 //! melt pool.
 
@@ -8,7 +8,7 @@ use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
 
-/// Heat diagnostics (issue 4). Melt pool (issue 29, crate::pool): the largest
+/// Heat diagnostics. Melt pool (crate::pool): the largest
 /// connected region of melt (liquid fraction ≥ ½); in scenes with a melt track
 /// the track sets its figures with the depth below the initial surface
 /// (crate::track), elsewhere the depth is its height. Melt in other regions
@@ -94,6 +94,49 @@ impl LaserBalance {
         } else {
             0.0
         }
+    }
+}
+
+/// The ray-traced laser's split over a run: summed over the states read back
+/// (each output interval's last step) while the beam was on, so a user reads
+/// the absorbed fraction a calorimeter would, not the last step's (zero once
+/// the beam is off).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct LaserSummary {
+    /// States read back with the beam on.
+    pub samples: u32,
+    /// Mean incident and absorbed power over them (W; W/m in 2D).
+    pub incident_mean: f64,
+    pub absorbed_mean: f64,
+    /// Σ absorbed / Σ incident.
+    pub absorbed_fraction: f64,
+    /// The least and largest fraction of one sample.
+    pub fraction_min: f64,
+    pub fraction_max: f64,
+    /// Mean power absorbed at the bounce limit (W; W/m in 2D).
+    pub at_limit_mean: f64,
+}
+
+impl LaserSummary {
+    /// Takes in one state's split; a step without incident power is skipped.
+    pub fn add(&mut self, b: &LaserBalance) {
+        if b.incident <= 0.0 {
+            return;
+        }
+        let f = b.fraction();
+        let n = self.samples as f64;
+        if self.samples == 0 {
+            self.fraction_min = f;
+            self.fraction_max = f;
+        } else {
+            self.fraction_min = self.fraction_min.min(f);
+            self.fraction_max = self.fraction_max.max(f);
+        }
+        self.incident_mean = (self.incident_mean * n + b.incident) / (n + 1.0);
+        self.absorbed_mean = (self.absorbed_mean * n + b.absorbed) / (n + 1.0);
+        self.at_limit_mean = (self.at_limit_mean * n + b.at_limit) / (n + 1.0);
+        self.absorbed_fraction = self.absorbed_mean / self.incident_mean;
+        self.samples += 1;
     }
 }
 

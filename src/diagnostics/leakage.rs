@@ -1,4 +1,4 @@
-//! Wall leakage (issue 18): how deep fluid gets behind the closed wall faces. Each
+//! Wall leakage: how deep fluid gets behind the closed wall faces. Each
 //! `/diagnostics` record carries one state's; the run keeps the worst over every
 //! state it reads back (`RunReport::leakage`). The watchdog stops a run on its own
 //! threshold (`Model::wall_stop_depth`), not on this tally.
@@ -6,7 +6,7 @@
 use crate::model::Model;
 use crate::state::State;
 
-/// Fluid leaking into the wall layers (issue 18): the deepest penetration behind a
+/// Fluid leaking into the wall layers: the deepest penetration behind a
 /// closed wall face and how many fluid particles are more than ½Δx behind one.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Leakage {
@@ -76,7 +76,7 @@ mod tests {
     use super::*;
     use crate::scene::PhaseKind;
 
-    /// Issue 18: penetration behind a closed face is measured in Δx, the deepest
+    /// Penetration behind a closed face is measured in Δx, the deepest
     /// kept with its particle and face, and counted beyond ½Δx.
     #[test]
     fn leakage_measures_depth_behind_wall_faces() {
@@ -84,10 +84,10 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/dam_break_2d.toml"
         );
-        let crate::run::Loaded {
+        let crate::load::Loaded {
             model: m,
             mut state,
-        } = crate::run::load(path, &[]).unwrap();
+        } = crate::load::load(path, &[]).unwrap();
         let st = &mut state;
         assert_eq!(Leakage::of(&m, st).deepest_dx, 0.0);
         let f: Vec<usize> = (0..st.len())

@@ -1,4 +1,4 @@
-//! Diagnostics (issue 3): what the run records about each state it reads back,
+//! Diagnostics: what the run records about each state it reads back,
 //! besides the frames. The `/diagnostics` record (energy, mass, density, per-phase
 //! counts, with the wall-leakage and outflow roll-ups and the heat and surface
 //! figures), the `/bodies` message, and the JSON schemas of every JSON topic of the
@@ -10,7 +10,9 @@ mod leakage;
 mod schema;
 mod surface;
 
-pub use heat::{heat_diagnostics, set_pool, surface_loss_power, HeatDiagnostics, LaserBalance};
+pub use heat::{
+    heat_diagnostics, set_pool, surface_loss_power, HeatDiagnostics, LaserBalance, LaserSummary,
+};
 pub use leakage::Leakage;
 pub use schema::{bodies_schema, check_schema, diagnostics_schema, removal_schema, track_schema};
 pub use surface::{surface_diagnostics, SurfaceDiagnostics, INTERIOR_SHEPARD};
@@ -94,10 +96,10 @@ pub struct Diagnostics {
     /// Particles in the domain per phase.
     pub particles: std::collections::BTreeMap<String, u64>,
     /// Particles that have left the domain per phase, and their mass (kg; per
-    /// metre of depth in 2D) (issue 18).
+    /// metre of depth in 2D).
     pub removed: std::collections::BTreeMap<String, u64>,
     pub removed_mass: std::collections::BTreeMap<String, f64>,
-    /// Deepest fluid penetration behind a wall face, in Δx (issue 18).
+    /// Deepest fluid penetration behind a wall face, in Δx.
     pub wall_penetration_max_dx: f64,
     /// Fluid particles more than ½Δx behind a wall face.
     pub wall_penetration_count: u64,

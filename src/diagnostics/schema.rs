@@ -164,7 +164,7 @@ pub fn bodies_schema() -> serde_json::Value {
     serde_json::json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "spatter.Bodies",
-        "description": "Every rigid body's motion at one frame (issue 17).",
+        "description": "Every rigid body's motion at one frame.",
         "type": "object",
         "properties": {
             "time": {"type": "number", "description": "s"},

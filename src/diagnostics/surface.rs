@@ -1,11 +1,11 @@
-//! Surface-force figures of a `/diagnostics` record (issue 16).
+//! Surface-force figures of a `/diagnostics` record.
 
 use crate::model::Model;
 use crate::scene::PhaseKind;
 use crate::state::State;
 use serde::Serialize;
 
-/// Surface-force diagnostics (issue 16): the liquid's surface as the interface
+/// Surface-force diagnostics: the liquid's surface as the interface
 /// pass sees it (Σ V δ over liquid particles with a normal: m² in 3D, m per metre
 /// of depth in 2D), its δ-weighted mean curvature (1/m; scenes with surface
 /// tension, 0 otherwise; on δ-SPH without gas over the particles the tension

@@ -3,11 +3,12 @@
 
 use super::*;
 
-pub(super) fn domain_box(
-    cx: &Ctx,
-    scene: &SceneFile,
-    dim: u32,
-) -> Result<([f64; 3], [f64; 3], [bool; 3]), InputError> {
+/// The box's low and high corners and its periodic axes.
+type DomainBox = ([f64; 3], [f64; 3], [bool; 3]);
+/// The cell grid: its origin, cells per axis and cell size.
+type CellGrid = ([f64; 3], [u32; 3], [f64; 3]);
+
+pub(super) fn domain_box(cx: &Ctx, scene: &SceneFile, dim: u32) -> Result<DomainBox, InputError> {
     let lo = cx.vector("domain.min", &scene.domain.min, dim)?;
     let hi = cx.vector("domain.max", &scene.domain.max, dim)?;
     for a in 0..dim as usize {
@@ -145,7 +146,7 @@ pub(super) fn cell_grid(
     support: f64,
     dx: f64,
     wall_layers: u32,
-) -> Result<([f64; 3], [u32; 3], [f64; 3]), InputError> {
+) -> Result<CellGrid, InputError> {
     let mut origin = [0.0; 3];
     let mut grid = [1u32; 3];
     let mut cell = [1.0; 3];

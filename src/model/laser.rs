@@ -65,7 +65,7 @@ pub fn hagen_rubens_index(resistivity: f64, wavelength: f64) -> f64 {
     1.0 / (2.0 * EPSILON_0 * omega * resistivity).sqrt()
 }
 
-/// A validated laser source (issue 4). Lateral coordinates are absolute.
+/// A validated laser source. Lateral coordinates are absolute.
 #[derive(Debug, Clone)]
 pub struct Laser {
     pub model: crate::scene::LaserModel,

@@ -186,7 +186,10 @@ mod tests {
             loop {
                 let dt = match toward_end(1.0, t, 0.01) {
                     Some(dt) => {
-                        assert!(dt >= 0.01 * 7.0 / 8.0 && dt <= 0.01 * END_STRETCH, "{dt}");
+                        assert!(
+                            (0.01 * 7.0 / 8.0..=0.01 * END_STRETCH).contains(&dt),
+                            "{dt}"
+                        );
                         dt
                     }
                     None if 1.0 - t <= END_SLACK => break,

@@ -42,7 +42,7 @@ pub struct DtLimits {
     pub acoustic: f64,
     pub viscous: f64,
     pub body_force: f64,
-    /// 0.1 ρ c_p h²/k over conducting phases (issue 4); ∞ without heat.
+    /// 0.1 ρ c_p h²/k over conducting phases; ∞ without heat.
     pub conduction: f64,
     /// F22 (42) 0.22 √(m/k_b) with the lightest fluid particle; ∞ without barrier.
     pub barrier: f64,
@@ -624,9 +624,9 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         }
         if c.kind == crate::scene::CheckKind::ContactAngle
             && (dim != 2
-                || !surface_tension
+                || surface_tension
                     .as_ref()
-                    .is_some_and(|s| s.contact_angle.is_some()))
+                    .is_none_or(|s| s.contact_angle.is_none()))
         {
             return Err(cx.err(
                 "check.kind",
@@ -964,7 +964,7 @@ fn delta_coefficient(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Option<
     }
 }
 
-/// `run.stop_when = "solidified"` (issue 29 item 5): a laser scene with a
+/// `run.stop_when = "solidified"`: a laser scene with a
 /// melting phase whose power table ends at 0 W; (beam off from, grace).
 fn stop_when(
     cx: &Ctx,
@@ -992,7 +992,7 @@ fn stop_when(
         ));
     };
     match l.power.last() {
-        Some(&(t_off, p)) if p == 0.0 => Ok(Some((t_off, grace))),
+        Some(&(t_off, 0.0)) => Ok(Some((t_off, grace))),
         _ => Err(cx.err(
             "run.stop_when",
             "\"solidified\": the beam never turns off (laser.power must end with a [time, 0.0] point)",
@@ -1000,7 +1000,7 @@ fn stop_when(
     }
 }
 
-/// Issue 29: surface tension with gas at a density ratio of 10 or more and no
+/// Surface tension with gas at a density ratio of 10 or more and no
 /// liquid–gas interface viscosity: such a drop disperses into its gas within a
 /// few oscillations (measured at ratio 100: square_drop_2d with its viscosities
 /// cut, 14 of 256 particles alone in the gas by 0.28 s); F22 damps the

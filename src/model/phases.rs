@@ -77,10 +77,7 @@ impl LawTable {
     }
     /// y(T), continued along the end segments.
     pub fn extrapolated(&self, t: f64) -> f64 {
-        let k = (1..self.n)
-            .filter(|&i| t >= self.points[i].0)
-            .last()
-            .unwrap_or(0);
+        let k = (1..self.n).rfind(|&i| t >= self.points[i].0).unwrap_or(0);
         self.points[k].1 + self.slope(k) * (t - self.points[k].0)
     }
     /// y(T), held at the end values beyond.

@@ -379,8 +379,8 @@ mod tests {
     /// R18 (4.2) for 304 SS (σ0 = 1.943 N/m, A = 5e-4 N/(m K), T_m = 1723 K,
     /// k_l = 0.0032, a_s = 0.0022 wt%, ΔH0 = −1.66e5 J/mol): with Γ_s in kmol/m²
     /// (Sahoo's unit) σ(T_m) = 1.8379 N/m and dσ/dT changes sign at 1713.06 K
-    /// (positive below: +2.62e-4 at 1600 K; −4.50e-4 at 2200 K), as
-    /// PAPERS-EXTRACT §5.8 derives; read as mol/m² (1.3e-11 kmol/m² here) the
+    /// (positive below: +2.62e-4 at 1600 K; −4.50e-4 at 2200 K). R18 prints
+    /// Γ_s = 1.3e-8 without its unit; read as mol/m² (1.3e-11 kmol/m² here) the
     /// term is 1e-4 N/m and dσ/dT within 1% of −A everywhere. The derivative is the
     /// analytic one: it matches a central difference to 1e-9 N/(m K).
     #[test]

@@ -147,7 +147,7 @@ pub(super) fn thermal_table(
                 // as L is the band's enthalpy beyond the sensible heat of the
                 // slope just below the solidus.
                 let rise = t.extrapolated(tl) - t.extrapolated(ts);
-                let below = (1..t.n).filter(|&i| ts > t.points[i].0).last().unwrap_or(0);
+                let below = (1..t.n).rfind(|&i| ts > t.points[i].0).unwrap_or(0);
                 Some((ts, tl, (rise - t.slope(below) * (tl - ts)).max(0.0)))
             }
             (Some(ts), Some(tl), Some(l), None) => {

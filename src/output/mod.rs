@@ -1,4 +1,4 @@
-//! Run outputs (issue 3): the sinks (MCAP stream, VTK series) and the per-particle
+//! Run outputs: the sinks (MCAP stream, VTK series) and the per-particle
 //! channels every frame carries. What else the stream records (diagnostics,
 //! removals, the track, the bodies) is built in crate::diagnostics and handed to
 //! the sinks as JSON messages.
@@ -56,7 +56,7 @@ pub struct Field {
 /// in scenes with rigid bodies `body` (index + 1 of its body, 0 none).
 ///
 /// Frames hold the particles still in the simulation only: the removed ones (the
-/// last `sim.removed` of the state, issue 18) are left out, so they do not hang
+/// last `sim.removed` of the state) are left out, so they do not hang
 /// frozen where they left in every later frame; `/removed` records them.
 pub fn particle_fields(m: &Model, st: &State) -> Vec<Field> {
     let held = crate::fields::Held::of_state(st);
@@ -183,8 +183,8 @@ pub fn velocity_channels(_m: &Model, st: &State) -> Vec<Field> {
 /// temperature, with liquid fraction and enthalpy 0, so that a colour scale over
 /// the frame stays within the temperatures the scene has (0 K used to stretch it).
 /// A Dirichlet wall particle is written at its fixed temperature (heat.x), not
-/// at the mirror temperature 2 T_wall − T̃ the conduction pass gives it (issue
-/// 29: down to −681 K beside a hot pool), with enthalpy 0: a wall has none.
+/// at the mirror temperature 2 T_wall − T̃ the conduction pass gives it
+/// (measured down to −681 K beside a hot pool), with enthalpy 0: a wall has none.
 pub fn heat_channels(m: &Model, st: &State) -> Vec<Field> {
     if st.heat.is_empty() {
         return Vec::new();

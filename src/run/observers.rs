@@ -29,6 +29,7 @@ pub struct Findings {
     pub check: Option<CheckResult>,
     pub leakage: Leakage,
     pub track: Option<TrackProfile>,
+    pub laser: Option<crate::diagnostics::LaserSummary>,
 }
 
 /// A host-side observer of the states a run reads back.
@@ -66,6 +67,9 @@ pub fn list(m: &Model, opts: &RunOptions) -> Vec<Box<dyn Observer>> {
     }
     if crate::track::wanted(m) {
         list.push(Box::new(TrackObserver(None)));
+    }
+    if m.laser.as_ref().is_some_and(|l| l.rays.is_some()) {
+        list.push(Box::<LaserAbsorption>::default());
     }
     if m.melts() {
         list.push(Box::<SolidificationRecords>::default());
@@ -263,7 +267,7 @@ impl Observer for CheckObserver {
     }
 }
 
-/// Wall leakage (issue 18) over every state read back: the deepest penetration,
+/// Wall leakage over every state read back: the deepest penetration,
 /// warned about once (on the first sample that has one) unless the run is quiet.
 struct WallLeakage {
     worst: Leakage,
@@ -302,7 +306,7 @@ impl Observer for WallLeakage {
     }
 }
 
-/// The melt track of a laser scene with melting (issue 16): started on the
+/// The melt track of a laser scene with melting: started on the
 /// initial state, it writes the depression under the beam and the pool's
 /// figures (crate::pool, depth below the initial surface) into each
 /// `/diagnostics` record and its profile to `/track` at the end.
@@ -338,6 +342,34 @@ impl Observer for TrackObserver {
             sink.message(TRACK_TOPIC, last.sim.time as f64, &profile)?;
         }
         found.track = Some(profile);
+        Ok(())
+    }
+}
+
+/// The ray-traced laser's absorbed fraction over the run, from the power split
+/// of each state read back with the beam on.
+#[derive(Default)]
+struct LaserAbsorption(crate::diagnostics::LaserSummary);
+
+impl Observer for LaserAbsorption {
+    fn observe(&mut self, m: &Model, st: &State, when: Moment) {
+        if matches!(when, Moment::Sample { .. } | Moment::Final) {
+            if let Some(b) = crate::diagnostics::LaserBalance::of(m, st) {
+                self.0.add(&b);
+            }
+        }
+    }
+    fn finish(
+        self: Box<Self>,
+        _m: &Model,
+        _last: &State,
+        _end: &RunEnd,
+        _out: &mut Outputs,
+        found: &mut Findings,
+    ) -> Result<(), String> {
+        if self.0.samples > 0 {
+            found.laser = Some(self.0);
+        }
         Ok(())
     }
 }

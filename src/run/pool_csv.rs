@@ -1,5 +1,5 @@
-//! The melt pool's time series as CSV (issue 29 item 1, `spatter run --out
-//! RUN.mcap --pool-csv`): one row per `/diagnostics` record of a heat scene,
+//! The melt pool's time series as CSV (`spatter run --out RUN.mcap
+//! --pool-csv`): one row per `/diagnostics` record of a heat scene,
 //! written beside the MCAP as RUN.pool.csv and flushed per row, so a run that
 //! stops leaves every row so far readable. The figures are the record's
 //! (crate::pool: the largest connected region of melt, detached melt apart).

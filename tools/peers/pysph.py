@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""spatter against PySPH on PySPH's 3D dam break (issue 15, item 4).
+"""spatter against PySPH on PySPH's 3D dam break.
 
     python3 tools/peers/pysph.py [--install] [--until 0.05] [--dx 0.02] [--binary PATH]
 

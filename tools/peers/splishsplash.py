@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""spatter against pySPlisHSPlasH on its DamBreakModel scene (issue 15, item 4).
+"""spatter against pySPlisHSPlasH on its DamBreakModel scene.
 
     python3 tools/peers/splishsplash.py [--install] [--until 0.3] [--binary PATH]
 

@@ -6,7 +6,7 @@
 //! so ψ_ij·∇_iW_ij = −(2 (ρ̄_j − ρ̄_i) + (⟨∇ρ̄⟩_i + ⟨∇ρ̄⟩_j)·r_ij) (∂W/∂r)/r, with
 //! Antuono et al. (2010)'s renormalised gradient (`gradients`; R18's optional
 //! f_l). R18 (3.14) prints the diffusion
-//! inside the velocity bracket, multiplied by ρ (PAPERS-EXTRACT §5.4 flags it);
+//! inside the velocity bracket, multiplied by ρ (dimensionally odd);
 //! this is Antuono's form. Diffusing the excess, not ρ, keeps a temperature-
 //! dependent ρ0 from driving a flux (R18 §3.4). The diffusion acts between
 //! particles of the same phase only: across a liquid–gas interface a liquid's

@@ -20,8 +20,8 @@
 //!   and α_i = ρ_i / (G·(G + B) + Σ_f |g_f|²) with g_f = m_f ∇W_if,
 //!   g_b = Ψ_b ∇W_ib, G = Σ_all g, B = Σ_b g_b: the exact diagonal of the
 //!   update below (B&K 2017 (11) with the mirrored wall); 0 when not positive.
-//! - Both solves apply Δv_i = −Δt (Σ_f m_f (κ_i/ρ_i + κ_f/ρ_f) ∇W_if
-//!   + Σ_b 2 Ψ_b (κ_i/ρ_i) ∇W_ib) with the increment of κ (B&K 2017 (12)), and
+//! - Both solves apply Δv_i = −Δt (Σ_f m_f (κ_i/ρ_i + κ_f/ρ_f) ∇W_if +
+//!   Σ_b 2 Ψ_b (κ_i/ρ_i) ∇W_ib) with the increment of κ (B&K 2017 (12)), and
 //!   Dρ_i/Dt = Σ_f m_f (v_i − v_f)·∇W_if + Σ_b Ψ_b (v_i − v_b)·∇W_ib.
 //!   - The iteration is a projected, relaxed Jacobi (SPlisHSPlasH 2.12's):
 //!     Σκ_i ← max(Σκ_i + ½ α_i e_i / s, 0), e the divergence error Dρ/Dt
@@ -49,8 +49,13 @@
 //! - Measured: the 2D hydrostatic column (0.4 m, Δx = 1 cm) holds its pressure
 //!   to 1.2% rms of ρ g H at the default tolerance 1e-3 (1.0% at 1e-4, 7× the
 //!   wall time).
-//! - Not yet: J22's implicit viscosity and corrections (17), one-layer Akinci
-//!   boundaries, moving walls and rigid bodies.
+//! - J22's implicit viscosity with XSPH, cohesion and adhesion (J22 (14)–(17))
+//!   are in dfsph_viscosity.rs. J22's one-layer Akinci boundary
+//!   (`dfsph.boundary = "akinci"`) enters through the wall masses: setup
+//!   gives each wall particle m_b = ρ0_b V_b with Akinci's V_b (setup.rs,
+//!   akinci_wall_masses), so V_b = m_b/ρ0_b above reads it.
+//! - Not yet: moving walls and rigid bodies (model/mod.rs refuses them on
+//!   DFSPH).
 
 use super::dfsph_pairs::{for_each_pair, Pair, PairChunk, PairTable};
 use super::integrate::{stamp_if_left, wrap_periodic};
@@ -99,6 +104,7 @@ impl FactorSums {
     /// Adds neighbour j at x_ij = d, r² < support², with W(r) = w and
     /// ∂W/∂r / r = dw (unused at r = 0); records the pair j ≠ i.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)] // the pair as the sweep holds it: no struct to build per pair
     fn add(
         &mut self,
         st: &State,
@@ -248,8 +254,8 @@ pub fn factor(
     let pair_chunks = table.take_chunks(n.div_ceil(LIST_CHUNK));
     let s: &State = st;
     type Chunked = (Vec<(f32, f32)>, (ListChunk, PairChunk));
-    let (out, (chunks, pair_chunks)): (Vec<Vec<(f32, f32)>>, (Vec<ListChunk>, Vec<PairChunk>)) = (0
-        ..n.div_ceil(LIST_CHUNK))
+    type Gathered = (Vec<Vec<(f32, f32)>>, (Vec<ListChunk>, Vec<PairChunk>));
+    let (out, (chunks, pair_chunks)): Gathered = (0..n.div_ceil(LIST_CHUNK))
         .into_par_iter()
         .zip(chunks)
         .zip(pair_chunks)
@@ -574,7 +580,7 @@ mod tests {
                 "initial_pressure=\"zero\"".into(),
                 "jitter=0.3".into(),
             ];
-            let l = crate::run::load(&path, &sets).unwrap();
+            let l = crate::load::load(&path, &sets).unwrap();
             let pr = Params::new(&l.model, l.state.len() as u32);
             let mut st = l.state.clone();
             let mut grid = CellTable::default();

@@ -41,11 +41,11 @@
 //!   viscosity).
 //! - Scalars in the solver's slot: r·z, r0·r0, α, β.
 //! - J22's cohesion (15) and adhesion (16) as printed: on the right side,
-//!   with this step's positions (PAPERS-EXTRACT flags whether J22 predicts
-//!   them; the text says "implicit", the equation depends on x^t only).
+//!   with this step's positions (J22 does not say whether it predicts
+//!   them: its text says "implicit", its equation depends on x^t only).
 //!   γ is read per unit mass, in 1/s² (J22 prints N/m): J22's γ = 200 then
 //!   gives about 2e-5 m/s² at Δx = 0.8 µm, nothing against a 200 m/s impact,
-//!   so J22's value is not the scene's (issue 30's note).
+//!   so J22's value is not the scene's (docs/physics.md, DFSPH).
 
 use super::dfsph_pairs::{for_each_pair, Pair, PairTable};
 use super::neighbors::{for_each_neighbor, for_each_neighbor_among, Among, CellTable, LIST_CHUNK};
@@ -181,8 +181,8 @@ pub struct Couplings {
     chunks: Vec<Vec<[f32; 3]>>,
 }
 
-/// Sums of fluid particle i's row: Σ_j [−k_p x_ij (x_ij·u_ij) − k_i u_ij
-/// + s_ij u_ij], u_ij the difference of `field` (a wall's value: `wall`),
+/// Sums of fluid particle i's row: Σ_j [−k_p x_ij (x_ij·u_ij) − k_i u_ij +
+/// s_ij u_ij], u_ij the difference of `field` (a wall's value: `wall`),
 /// and the diagonal m_i + Σ_j (−k_p x_ij,a² − k_i + s_ij).
 struct Row<F, G> {
     acc: [f32; 3],

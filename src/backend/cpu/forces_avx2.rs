@@ -318,7 +318,7 @@ mod tests {
             "{}/scenarios/validation/dam_break_3d.toml",
             env!("CARGO_MANIFEST_DIR")
         );
-        let l = crate::run::load(&path, &["jitter=0.3".into()]).unwrap();
+        let l = crate::load::load(&path, &["jitter=0.3".into()]).unwrap();
         let mut pr = Params::new(&l.model, 2);
         let mut st = l.state.clone();
         for (k, v) in st.vel.iter_mut().enumerate() {

@@ -400,6 +400,8 @@ fn table_temperature_of(pr: &Params, phase: u32, h: f32) -> (f32, f32) {
     let t = row.temperature[c] + (h - row.value[c]) / row.slope[c];
     if m.flags & HEAT_MELTS != 0 {
         let fl = (t - m.solidus) / (m.liquidus - m.solidus);
+        // min(max()) as the WGSL twin writes it (clamp differs on NaN).
+        #[allow(clippy::manual_clamp)]
         return (t, fl.max(0.0).min(1.0));
     }
     (t, if m.flags & HEAT_LIQUID != 0 { 1.0 } else { 0.0 })
@@ -531,11 +533,11 @@ struct Found {
     crossing: Option<Crossing>,
 }
 
-/// A liquidus crossing on cooling in this step (issue 29's solidification
+/// A liquidus crossing on cooling in this step (the solidification
 /// record; twin of record_liquidus_crossing in shaders/heat.wgsl): t_start ≥ T_l
 /// > T at the step's end, t_start the step's first temperature (the trapezoidal
-/// iterates overwrote heat.y: T(h^n) then). The time is linear in T within the
-/// step, the cooling rate −(dh/dt)/c_l the liquid side's at the step's rate.
+/// > iterates overwrote heat.y: T(h^n) then). The time is linear in T within the
+/// > step, the cooling rate −(dh/dt)/c_l the liquid side's at the step's rate.
 struct Crossing {
     time: f32,
     cooling: f32,
@@ -613,7 +615,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/adiabatic_box.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let pr = Params::new(&l.model, l.state.len() as u32);
         let hot = l.model.phase_index("hot").unwrap();
         let th = l.model.phases[hot].thermal.unwrap();

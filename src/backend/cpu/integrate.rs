@@ -45,8 +45,8 @@ pub fn kick_drift(pr: &Params, st: &mut State) {
 }
 
 /// A fluid particle that has just left the keep box carries the time it left in
-/// w; the neighbour pass then sorts it last and the passes stop before it (issue
-/// 18). Walls are never removed.
+/// w; the neighbour pass then sorts it last and the passes stop before it.
+/// Walls are never removed.
 #[inline(always)]
 pub(super) fn stamp_if_left(pr: &Params, x: &mut [f32; 4], left_at: f32) {
     if pr.outside_keep_box(x) {
@@ -109,7 +109,7 @@ mod tests {
             "phases.lid.moves=true".to_string(),
             "phases.lid.velocity=[2.0e-3, 0.0]".to_string(),
         ];
-        let l = crate::run::load(path, &sets).unwrap();
+        let l = crate::load::load(path, &sets).unwrap();
         let pr = Params::new(&l.model, l.state.len() as u32);
         let lid = l.model.phase_index("lid").unwrap() as u32;
         let wall = l.model.phase_index("wall").unwrap() as u32;
@@ -137,7 +137,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/melt_block_3d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let pr = Params::new(&l.model, l.state.len() as u32);
         let melt = l.model.phase_index("melt").unwrap() as u32;
         let mut st = l.state.clone();

@@ -189,7 +189,7 @@ fn solid_weight(pr: &Params, st: &State, j: usize) -> f32 {
 /// tension pair with the standard normal ñ (`n`): the solid colour c^sf = Σ_j V_j
 /// χ_j W_ij and its gradient Σ_j V_j χ_j ∇_iW_ij over wall and solid neighbours
 /// (V = m/ρ0) give n^sf (towards the solid; kept ñ where |∇c^sf| ≤ 0.1/h); the
-/// tangent t = ñ − (ñ·n^sf) n^sf normalised (PAPERS-EXTRACT §1.5: F22 (28)
+/// tangent t = ñ − (ñ·n^sf) n^sf normalised (F22 (28)
 /// prints n̂ there, which is circular), n̂ = t sin θ − n^sf cos θ with θ = θ0 for
 /// the liquid and π − θ0 for the gas (its normal points the other way), and
 /// n = normalise(f n̂ + (1 − f) ñ), f = f[c^sf, 0, 0.2] (F22's c1, c2); δ kept.

@@ -13,6 +13,7 @@
 //! 3. deposit: each absorbing particle takes from its neighbouring bins the share
 //!    wV/Σ wV of their power, as a source q = P/m (W/kg) in heat.w for the
 //!    conduction pass.
+//!
 //! Portable exp (src/portable_math.rs) keeps it bit-identical to the GPU.
 //!
 //! ray_traced: bins as above (with the volume-weighted optical constants

@@ -369,7 +369,7 @@ mod tests {
     fn recorded_pairs_give_the_bits_of_the_sweep() {
         for scene in ["spray/j22_fluent_case_2d", "validation/poiseuille_dfsph_2d"] {
             let path = format!("{}/scenarios/{scene}.toml", env!("CARGO_MANIFEST_DIR"));
-            let l = crate::run::load(&path, &[]).unwrap();
+            let l = crate::load::load(&path, &[]).unwrap();
             let params = || Params::new(&l.model, l.state.len() as u32);
             let mut recorded = CpuBackend::new(params(), l.state.clone());
             let mut swept = CpuBackend::new(params(), l.state.clone());

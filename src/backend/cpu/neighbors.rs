@@ -776,7 +776,7 @@ fn wrap(c: i32, n: u32, periodic: bool) -> Option<u32> {
 }
 
 /// The cell a particle sorts into; n_cells, after every cell and in none, for
-/// one that has left the domain (issue 18): a fluid particle outside the keep
+/// one that has left the domain: a fluid particle outside the keep
 /// box, or a wall-kind particle stamped with the time it left (a member of a
 /// rigid body that left, `bodies::place`; it may stand anywhere, its body's
 /// centre is past the face). Other walls stay wherever they stand (those of a
@@ -945,7 +945,7 @@ mod tests {
             "{}/scenarios/validation/{scene}.toml",
             env!("CARGO_MANIFEST_DIR")
         );
-        let l = crate::run::load(&path, &["jitter=0.3".into()]).unwrap();
+        let l = crate::load::load(&path, &["jitter=0.3".into()]).unwrap();
         let pr = Params::new(&l.model, 2);
         let mut st = l.state.clone();
         let mut grid = CellTable::default();

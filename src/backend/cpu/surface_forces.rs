@@ -169,7 +169,7 @@ pub fn surface_tension(pr: &Params, st: &mut State, grid: &CellTable) {
 /// R18's 0/1 mask those rows reached the cap within 0.01 s on the free disc and
 /// their κ spread into the surface row through the smoothing (Laplace jump at
 /// R = 20Δx +459% with the mask, +285% with δ; +206% and +211% at 10Δx: neither
-/// is right, see laplace_free_disc_2d and the note on issue 16).
+/// is right, see laplace_free_disc_2d in docs/validation.md).
 pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
     let (n, active) = (st.len(), st.active());
     let s: &State = st;
@@ -225,7 +225,7 @@ pub fn tension_curvature(pr: &Params, st: &mut State, grid: &CellTable) {
 /// The free-surface form's force (second dispatch): the raw curvature smoothed,
 /// R18 (3.30), κ_i = Σ_j f_j V_j δ_j κ_j W_ij / Σ_j f_j V_j δ_j W_ij over the same
 /// neighbours and weights (to surface[n + i].y); the temperature gradient Shepard-corrected,
-/// R18 (3.34) as PAPERS-EXTRACT §5.3 reads it, ∇T_i = Σ_j V_j (T_j − T_i) W'_ij e_ij
+/// R18 (3.34) (garbled as printed) read as ∇T_i = Σ_j V_j (T_j − T_i) W'_ij e_ij
 /// / Σ_j V_j W_ij over the neighbours with a temperature (the missing outside
 /// would bias the plain sum at the surface); then F22 (24)'s force, as in the gas
 /// form, a_i = f[T_i] δ_i (α'_i ∇_t T_i − α_i κ_i n_i)/ρ0 (R18 (3.31), (3.35)).

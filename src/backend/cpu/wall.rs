@@ -128,7 +128,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/scenarios/validation/dam_break_2d.toml"
         );
-        let l = crate::run::load(path, &[]).unwrap();
+        let l = crate::load::load(path, &[]).unwrap();
         let water = l.model.phase_index("water").unwrap() as u32;
         let st0 = &l.state;
         let w = (0..st0.len()).find(|&i| st0.phase[i] != water).unwrap();
@@ -165,7 +165,7 @@ mod tests {
                 "{}/scenarios/validation/{scene}.toml",
                 env!("CARGO_MANIFEST_DIR")
             );
-            let l = crate::run::load(&path, &["jitter=0.3".into()]).unwrap();
+            let l = crate::load::load(&path, &["jitter=0.3".into()]).unwrap();
             let pr = Params::new(&l.model, 2);
             let mut st = l.state.clone();
             for (k, (v, p)) in st.vel.iter_mut().zip(st.press.iter_mut()).enumerate() {

@@ -1,5 +1,5 @@
-//! Adapter and device selection. Vulkan only: DESIGN.md found GL/llvmpipe
-//! reassociates float math, which breaks the bit-match contract.
+//! Adapter and device selection. Vulkan only: GL/llvmpipe reassociates float
+//! math (measured, docs/design.md), which breaks the bit-match contract.
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AdapterChoice {

@@ -15,7 +15,7 @@
 //!
 //! with `ci` the particle's cell and `zr` its z reach (`z_range()`), and the
 //! template expands to the dz / dy / row-segment / j loops every pass had written
-//! out before (issue 14), character for character, so the compiled loops are the
+//! out before the template, character for character, so the compiled loops are the
 //! ones that were measured on hardware. The Rust twin is
 //! `backend::cpu::neighbors::for_each_neighbor`: same cells, same order.
 

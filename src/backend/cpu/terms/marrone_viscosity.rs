@@ -2,7 +2,7 @@
 //!   a_i = K Σ_j m_j μ_ij/(ρ_i ρ_j) (u_ij·r_ij)/(r_ij² + η²) ∇_iW_ij,
 //! K = 2 (d + 2), μ_ij = 2 μ_i μ_j/(μ_i + μ_j) (F22 (23)'s pair viscosity: 0
 //! against a free-slip wall), η² = 0.01 h². R18 prints μ_i μ_j/(μ_i + μ_j) and
-//! a scalar (PAPERS-EXTRACT §5.4 flags it); with the harmonic mean the term is
+//! a scalar where an acceleration is meant; with the harmonic mean the term is
 //! (μ/ρ)(∇²u + 2∇(∇·u)) in the continuum, by its fourth kernel moment; on a
 //! lattice that moment converges slowly with h/Δx: for u = (y², 0) the sum
 //! gives 0.83 ∇²u at h = Δx (quintic), 0.92 at 1.2 Δx, 0.97 at 1.5 Δx, 0.99 at

@@ -2,6 +2,7 @@
 //! sense, plus the host-side time-step limits (F22 (42)).
 
 mod bodies;
+mod check_inputs;
 mod domain;
 pub mod expansion;
 mod laser;
@@ -404,40 +405,20 @@ impl Ctx<'_> {
     }
 }
 
-/// Validate a parsed scene and derive all constants.
+/// Validate a parsed scene and derive all constants: an assembly in which each
+/// section's owner validates its keys (resolution, domain, phases, the forces,
+/// the time-step limits, the run, the laser, the check, the watchdog), then
+/// the Model literal, one line per field (why it runs past 80 lines).
 pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model, InputError> {
     let cx = Ctx { file };
     let sim = &scene.simulation;
-    if sim.dimension != 2 && sim.dimension != 3 {
-        return Err(cx.err(
-            "simulation.dimension",
-            format!("must be 2 or 3 (got {})", sim.dimension),
-        ));
-    }
-    let dim = sim.dimension;
-    let dx = cx.positive("simulation.dx", sim.dx)?;
-    let h_over_dx = sim.h_over_dx.unwrap_or(sim.kernel.default_h_over_dx());
-    cx.positive("simulation.h_over_dx", h_over_dx)?;
-    if !(0.5..=3.0).contains(&h_over_dx) {
-        return Err(cx.err(
-            "simulation.h_over_dx",
-            format!("must lie in [0.5, 3] (got {h_over_dx})"),
-        ));
-    }
-    let h = h_over_dx * dx;
-    let support = sim.kernel.support_factor() * h;
-    let gravity = if sim.gravity.is_empty() {
-        [0.0; 3]
-    } else {
-        cx.vector("simulation.gravity", &sim.gravity, dim)?
-    };
-    cx.non_negative("simulation.background_pressure", sim.background_pressure)?;
-    if !(0.0..=0.5).contains(&sim.jitter) {
-        return Err(cx.err(
-            "simulation.jitter",
-            format!("must lie in [0, 0.5] (fraction of dx, got {})", sim.jitter),
-        ));
-    }
+    let Resolution {
+        dim,
+        dx,
+        h,
+        support,
+        gravity,
+    } = resolution(&cx, sim)?;
 
     let (domain_lo, domain_hi, periodic) = domain_box(&cx, scene, dim)?;
     let hydrostatic_axis = match sim.initial_pressure {
@@ -469,401 +450,55 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
     )?;
     check_walls(&cx, scene, &phases, dim, periodic)?;
 
-    let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
     let has_body =
         scene.shapes.iter().any(|s| s.body) || scene.powder.as_ref().is_some_and(|p| p.rigid);
-    if fluid.is_empty() && !phases.iter().any(|p| p.conducts()) && !has_body {
+    if !phases.iter().any(|p| p.is_fluid() || p.conducts()) && !has_body {
         return Err(cx.err(
             "phases",
             "the scene has no liquid, gas or solid phase nor a rigid body",
         ));
     }
-    let conduction = phases
-        .iter()
-        .filter(|p| p.conducts())
-        .map(|p| {
-            // the stiffer of the solid and liquid states: a melt whose
-            // conductivity is scaled (R18 §4.4's x10) diffuses faster
-            let t = p.thermal.unwrap();
-            let limit = |c: f64, k: f64| 0.1 * p.rho0 * c * h * h / k;
-            limit(t.heat_capacity, t.conductivity).min(limit(t.liquid.1, t.liquid.0))
-        })
-        .fold(f64::INFINITY, f64::min);
-    // DFSPH's pressure is implicit: no acoustic limit (the flow's CFL remains).
-    let c_max = if sim.formulation == crate::scene::Formulation::Dfsph {
-        0.0
-    } else {
-        fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max)
-    };
     let solid_fluid = solid_fluid_viscosity(&cx, sim, &phases)?;
-    // DFSPH's implicit viscosity has no time-step limit (the artificial
-    // viscosities stay explicit).
-    let implicit_viscosity = sim.formulation == crate::scene::Formulation::Dfsph
-        && sim.dfsph.unwrap_or_default().viscosity == crate::scene::DfsphViscosity::Implicit;
-    let nu_max = fluid
-        .iter()
-        .filter(|_| !implicit_viscosity)
-        .map(|p| p.viscosity / p.rho0)
-        .fold(
-            interface_viscosity_nu(&cx, sim, &fluid, dim, h, dx)?
-                + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
-            f64::max,
-        );
-    let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let barrier = barrier_def(&cx, sim, h, dx)?;
     let powder = powder_bed(&cx, scene, dim, &phases)?;
     let (bodies, contact) = bodies::bodies(&cx, scene, &phases, dim, periodic, powder.as_ref())?;
     let surface_tension = tension::surface_tension(&cx, scene, &phases, support, dx)?;
-    let limits = DtLimits {
-        acoustic: if c_max > 0.0 {
-            0.25 * h / c_max
-        } else {
-            f64::INFINITY
-        },
-        viscous: if nu_max > 0.0 {
-            0.125 * h * h / nu_max
-        } else {
-            f64::INFINITY
-        },
-        body_force: if g > 0.0 {
-            0.25 * (h / g).sqrt()
-        } else {
-            f64::INFINITY
-        },
-        conduction,
-        barrier: match &barrier {
-            Some(b) => {
-                let m_min = fluid.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
-                0.22 * (m_min / b.stiffness).sqrt()
-            }
-            None => f64::INFINITY,
-        },
-        capillary: surface_tension.as_ref().map_or(f64::INFINITY, |s| {
-            let rho = s.gas.map_or(phases[s.liquid].rho0, |g| {
-                phases[s.liquid].rho0.min(phases[g].rho0)
-            });
-            0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(&phases)))
-                .sqrt()
-        }),
-        contact: bodies::contact_limit(&bodies, &phases, contact),
-        maximum: match scene.run.max_dt {
-            Some(_) if scene.run.dt.is_some() => {
-                return Err(cx.err("run.max_dt", "give dt (fixed) or max_dt (a cap), not both"));
-            }
-            Some(v) => cx.positive("run.max_dt", v)?,
-            None => f64::INFINITY,
-        },
-    };
+    let limits = dt_limits(
+        &cx,
+        scene,
+        &phases,
+        (dim, dx, h),
+        gravity,
+        solid_fluid,
+        barrier.as_ref(),
+        surface_tension.as_ref(),
+        (&bodies, contact),
+    )?;
 
     let run = &scene.run;
-    let fixed_dt = match run.dt {
-        Some(dt) => {
-            cx.positive("run.dt", dt)?;
-            let (lim, which) = limits.min();
-            if dt > lim && run.dt_check.unwrap_or(true) {
-                return Err(cx.err(
-                    "run.dt",
-                    format!(
-                        "fixed time step {dt:e} s exceeds the stability limit {lim:e} s ({which})"
-                    ),
-                ));
-            }
-            Some(dt)
-        }
-        None => None,
-    };
-    let end = match (run.end_time, run.steps) {
-        (Some(_), Some(_)) => return Err(cx.err("run", "give end_time or steps, not both")),
-        (Some(t), None) => EndCondition::Time(cx.positive("run.end_time", t)?),
-        (None, Some(n)) => EndCondition::Steps(n),
-        (None, None) => return Err(cx.err("run", "needs end_time or steps")),
-    };
-    let output_interval = match run.output_interval {
-        Some(v) => cx.positive("run.output_interval", v)?,
-        None => match end {
-            EndCondition::Time(t) => t / 20.0,
-            EndCondition::Steps(_) => f64::INFINITY,
-        },
-    };
-    let diagnostics_interval = match run.diagnostics_interval {
-        Some(v) => cx.positive("run.diagnostics_interval", v)?,
-        None => output_interval,
-    };
-    if let Some(c) = &scene.check {
-        cx.positive("check.tolerance", c.tolerance)?;
-        if c.kind == crate::scene::CheckKind::RecoilImpulse
-            || c.kind == crate::scene::CheckKind::ColumnExpansion
-        {
-            cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
-        }
-        if let Some(b) = c.band_tolerance {
-            cx.positive("check.band_tolerance", b)?;
-        }
-        if let Some(s) = c.swing {
-            cx.positive("check.swing", s)?;
-        }
-        if matches!(
-            c.kind,
-            crate::scene::CheckKind::ThermalExpansion
-                | crate::scene::CheckKind::RisingAmplitude
-                | crate::scene::CheckKind::ColumnExpansion
-        ) && !phases.iter().any(|p| p.density_law.is_some())
-        {
-            return Err(cx.err(
-                "check.kind",
-                "the expansion checks need a liquid with a density law (materials.<m>.density_law)",
-            ));
-        }
-        if c.kind == crate::scene::CheckKind::DropShape
-            && (dim != 2 || !surface_tension.as_ref().is_some_and(|s| s.is_constant()))
-        {
-            return Err(cx.err(
-                "check.kind",
-                "\"drop_shape\" needs a 2D scene with [surface_tension] of constant coefficient",
-            ));
-        }
-        if c.kind == crate::scene::CheckKind::ContactAngle
-            && (dim != 2
-                || surface_tension
-                    .as_ref()
-                    .is_none_or(|s| s.contact_angle.is_none()))
-        {
-            return Err(cx.err(
-                "check.kind",
-                "\"contact_angle\" needs a 2D scene with surface_tension.contact_angle",
-            ));
-        }
-        if c.kind == crate::scene::CheckKind::Thermocapillary {
-            thermocapillary_layout(&cx, scene, dim, &phases, surface_tension.as_ref(), c)?;
-        }
-        let droplet_check = matches!(
-            c.kind,
-            crate::scene::CheckKind::Splat | crate::scene::CheckKind::ImpactForce
-        );
-        if c.kind == crate::scene::CheckKind::ImpactForce && dim != 3 {
-            return Err(cx.err(
-                "check.kind",
-                "\"impact_force\" needs a 3D scene (its reference, 0.8 rho V^2 D^2, is a sphere's)",
-            ));
-        }
-        if droplet_check {
-            if let Some(name) = &c.phase {
-                if !phases
-                    .iter()
-                    .any(|p| &p.name == name && p.kind == PhaseKind::Liquid)
-                {
-                    return Err(cx.err(
-                        "check.phase",
-                        format!("`{name}` is not a liquid phase of the scene (the droplet)"),
-                    ));
-                }
-            }
-            if let Some(xi) = c.spread_factor {
-                if !(xi.is_finite() && xi >= 1.0) {
-                    return Err(cx.err(
-                        "check.spread_factor",
-                        format!("a spread factor D/D0 is at least 1, got {xi}"),
-                    ));
-                }
-            }
-        }
-        {
-            use crate::scene::CheckKind as K;
-            let traced = scene
-                .laser
-                .as_ref()
-                .is_some_and(|l| l.model == crate::scene::LaserModel::RayTraced);
-            if traced && matches!(c.kind, K::Rosenthal | K::LaserEnergy) {
-                return Err(cx.err(
-                    "check.kind",
-                    format!(
-                        "\"{}\" compares with a fixed absorptivity ζ: not with \
-                         laser.model = \"ray_traced\"",
-                        c.kind.name()
-                    ),
-                ));
-            }
-            let constant_reference = matches!(
-                c.kind,
-                K::Conduction1d
-                    | K::ConductionTwoMaterials
-                    | K::Stefan1d
-                    | K::SolidificationFront
-                    | K::Rosenthal
-            );
-            // A table that varies: λ not constant, or h(T) not one straight line.
-            let tabled = phases.iter().any(|p| {
-                p.thermal.is_some_and(|t| {
-                    t.conductivity_table
-                        .is_some_and(|tb| tb.points().iter().any(|q| q.1 != tb.points[0].1))
-                        || t.enthalpy_table.is_some_and(|tb| {
-                            (1..tb.n - 1)
-                                .any(|k| (tb.slope(k) - tb.slope(0)).abs() > 1e-9 * tb.slope(0))
-                        })
-                })
-            });
-            if constant_reference && tabled {
-                return Err(cx.err(
-                    "check.kind",
-                    format!(
-                        "\"{}\"'s reference solution takes constant properties: not with a \
-                         varying enthalpy_table or conductivity_table",
-                        c.kind.name()
-                    ),
-                ));
-            }
-        }
-        if droplet_check
-            && c.phase.is_none()
-            && phases
-                .iter()
-                .filter(|p| p.kind == PhaseKind::Liquid)
-                .count()
-                > 1
-        {
-            return Err(cx.err(
-                "check.phase",
-                format!(
-                    "missing: \"{}\" in a scene with several liquid phases needs the droplet's",
-                    c.kind.name()
-                ),
-            ));
-        }
-        if c.kind == crate::scene::CheckKind::DropContact
-            && !phases.iter().any(|p| {
-                p.kind == PhaseKind::Liquid && p.thermal.is_some_and(|t| t.melting.is_some())
-            })
-        {
-            return Err(cx.err(
-                "check.kind",
-                "\"drop_contact\" needs liquid drops whose material melts (solidus, liquidus)",
-            ));
-        }
-        if c.kind == crate::scene::CheckKind::Remelt {
-            let d = c.depth.unwrap_or(f64::NAN);
-            if !(d.is_finite() && d >= 0.0) {
-                return Err(cx.err(
-                    "check.depth",
-                    "\"remelt\" needs the reference depth (m, >= 0)",
-                ));
-            }
-            if !phases
-                .iter()
-                .any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some())
-            {
-                return Err(cx.err("check.kind", "\"remelt\" needs a solid phase that melts"));
-            }
-        }
-        if c.kind == crate::scene::CheckKind::PointMelt {
-            point_melt_needs(&cx, scene, &phases)?;
-        }
-        if c.kind == crate::scene::CheckKind::Deposition {
-            deposition_needs(&cx, scene, c)?;
-        }
-        if c.kind == crate::scene::CheckKind::Binder {
-            binder_needs(&cx, scene, c)?;
-        }
-        if c.kind == crate::scene::CheckKind::MeasuredTrack {
-            match (&c.measured, &scene.laser) {
-                (Some(d), Some(_)) => d.validate(file, dim)?,
-                (None, _) => return Err(cx.err(
-                    "check.measured",
-                    "missing: measured_track needs [check.measured] (width, depth, length, steady)",
-                )),
-                (_, None) => return Err(cx.err("check.kind", "\"measured_track\" needs a [laser]")),
-            }
-        }
-        if c.kind == crate::scene::CheckKind::Laplace {
-            cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), dim)?;
-            cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
-            if !surface_tension.as_ref().is_some_and(|s| s.is_constant()) {
-                return Err(cx.err(
-                    "check.kind",
-                    "\"laplace\" needs [surface_tension] with a constant coefficient",
-                ));
-            }
-        }
-    }
-    if let Some(w) = dispersion_risk(file, sim, &phases, surface_tension.as_ref()) {
-        warnings.push(w);
-    }
-    if let Some(w) = recoil_risk(file, &phases) {
-        warnings.push(w);
-    }
-    if let Some(w) = breakup_risk(file, sim, &phases, surface_tension.as_ref(), (dim, dx, h)) {
-        warnings.push(w);
-    }
+    let (fixed_dt, end, output_interval, diagnostics_interval) = run_timing(&cx, run, &limits)?;
     let laser = laser::laser_source(&cx, scene, dim, &phases)?;
-    if let Some(c) = scene
-        .check
-        .as_ref()
-        .filter(|c| c.kind == crate::scene::CheckKind::R18Track)
-    {
-        cx.positive(
-            "check.r18_slice_depth",
-            c.r18_slice_depth.unwrap_or(f64::NAN),
-        )?;
-        if !c.surface.is_some_and(f64::is_finite) {
-            return Err(cx.err(
-                "check.surface",
-                "\"r18_track\" needs the plate's initial top (m)",
-            ));
-        }
-        if laser.is_none() || dim != 2 {
-            return Err(cx.err(
-                "check.kind",
-                "\"r18_track\" needs a 2D scene with a [laser]",
-            ));
-        }
+    if let Some(c) = &scene.check {
+        let around = check_inputs::Around {
+            dim,
+            phases: &phases,
+            surface_tension: surface_tension.as_ref(),
+            has_laser: laser.is_some(),
+        };
+        check_inputs::validate(&cx, scene, c, &around)?;
     }
     let stop_when_solidified = stop_when(&cx, run, laser.as_ref(), &phases)?;
     let heat = heat_integration(&cx, scene, phases.iter().any(|p| p.thermal.is_some()))?;
     let delta = delta_coefficient(&cx, sim)?;
     let dfsph = dfsph_def(&cx, scene)?;
-    if delta.is_some() && sim.pressure_floor {
-        warnings.push(format!(
-            "{file}: key `simulation.pressure_floor`: on formulation = \"delta_wcsph\" the \
-             continuity density does not fall short at a free surface, and the floor takes \
-             away the tension that holds surface particles (a melting grain lost 2 particles \
-             and 8.5e-3 of its momentum with it, none and 9.4e-7 without); set it false"
-        ));
-    }
-    if surface_tension.as_ref().is_some_and(|s| s.colour_laplacian) {
-        warnings.push(format!(
-            "{file}: key `surface_tension.model`: J22 (5)-(8) as printed holds no drop together \
-             at a free surface. On the Laplace disc (R = 20 dx) summation density (wcsph, dfsph) \
-             leaves the colour at 0.99 on the surface and no force (jump -99.997%); on \
-             delta_wcsph the outer row is pushed outward (-98.8%, 40 of 1264 particles blown \
-             off). It is here to reproduce J22; model = \"csf\" is the surface tension"
-        ));
-    }
-    let wd = &scene.watchdog;
-    cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
-    cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
-    if let Some(depth) = wd.wall_penetration {
-        cx.positive("watchdog.wall_penetration", depth)?;
-    }
-    if !(wd.liquid_dispersion > 0.0 && wd.liquid_dispersion <= 1.0) {
-        return Err(cx.err(
-            "watchdog.liquid_dispersion",
-            format!("must be a share in (0, 1] (got {})", wd.liquid_dispersion),
-        ));
-    }
-    if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
-        return Err(cx.err(
-            "watchdog.max_density_ratio",
-            format!(
-                "must be a finite number above 1 (got {})",
-                wd.max_density_ratio
-            ),
-        ));
-    }
-    if wd.min_density_ratio >= 1.0 {
-        return Err(cx.err(
-            "watchdog.min_density_ratio",
-            format!("must be below 1 (got {})", wd.min_density_ratio),
-        ));
-    }
+    warnings.extend(risk_warnings(
+        file,
+        sim,
+        &phases,
+        surface_tension.as_ref(),
+        (dim, dx, h),
+    ));
+    watchdog_inputs(&cx, &scene.watchdog)?;
 
     Ok(Model {
         file: file.to_string(),
@@ -918,6 +553,260 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         dfsph,
         limits,
     })
+}
+
+/// The resolution and the frame: dimension, Δx, the smoothing length and
+/// support, gravity; the background pressure and the start's jitter.
+struct Resolution {
+    dim: u32,
+    dx: f64,
+    h: f64,
+    support: f64,
+    gravity: [f64; 3],
+}
+
+fn resolution(cx: &Ctx, sim: &crate::scene::Simulation) -> Result<Resolution, InputError> {
+    if sim.dimension != 2 && sim.dimension != 3 {
+        return Err(cx.err(
+            "simulation.dimension",
+            format!("must be 2 or 3 (got {})", sim.dimension),
+        ));
+    }
+    let dim = sim.dimension;
+    let dx = cx.positive("simulation.dx", sim.dx)?;
+    let h_over_dx = sim.h_over_dx.unwrap_or(sim.kernel.default_h_over_dx());
+    cx.positive("simulation.h_over_dx", h_over_dx)?;
+    if !(0.5..=3.0).contains(&h_over_dx) {
+        return Err(cx.err(
+            "simulation.h_over_dx",
+            format!("must lie in [0.5, 3] (got {h_over_dx})"),
+        ));
+    }
+    let h = h_over_dx * dx;
+    let support = sim.kernel.support_factor() * h;
+    let gravity = if sim.gravity.is_empty() {
+        [0.0; 3]
+    } else {
+        cx.vector("simulation.gravity", &sim.gravity, dim)?
+    };
+    cx.non_negative("simulation.background_pressure", sim.background_pressure)?;
+    if !(0.0..=0.5).contains(&sim.jitter) {
+        return Err(cx.err(
+            "simulation.jitter",
+            format!("must lie in [0, 0.5] (fraction of dx, got {})", sim.jitter),
+        ));
+    }
+    Ok(Resolution {
+        dim,
+        dx,
+        h,
+        support,
+        gravity,
+    })
+}
+
+/// The scene's constant time-step limits, F22 (42) with zero velocity: acoustic,
+/// viscous (the fluids', the interface and solid–fluid viscosities'), body
+/// force, conduction, barrier, capillary, contact and `run.max_dt`.
+#[allow(clippy::too_many_arguments)] // each limit's own inputs, built before it
+fn dt_limits(
+    cx: &Ctx,
+    scene: &SceneFile,
+    phases: &[PhaseInfo],
+    (dim, dx, h): (u32, f64, f64),
+    gravity: [f64; 3],
+    solid_fluid: Option<(f64, f64)>,
+    barrier: Option<&Barrier>,
+    surface_tension: Option<&SurfaceTension>,
+    (bodies, contact): (&[BodySpec], Option<Contact>),
+) -> Result<DtLimits, InputError> {
+    let sim = &scene.simulation;
+    let fluid: Vec<&PhaseInfo> = phases.iter().filter(|p| p.is_fluid()).collect();
+    let conduction = phases
+        .iter()
+        .filter(|p| p.conducts())
+        .map(|p| {
+            // the stiffer of the solid and liquid states: a melt whose
+            // conductivity is scaled (R18 §4.4's x10) diffuses faster
+            let t = p.thermal.unwrap();
+            let limit = |c: f64, k: f64| 0.1 * p.rho0 * c * h * h / k;
+            limit(t.heat_capacity, t.conductivity).min(limit(t.liquid.1, t.liquid.0))
+        })
+        .fold(f64::INFINITY, f64::min);
+    // DFSPH's pressure is implicit: no acoustic limit (the flow's CFL remains).
+    let c_max = if sim.formulation == crate::scene::Formulation::Dfsph {
+        0.0
+    } else {
+        fluid.iter().map(|p| p.sound_speed).fold(0.0, f64::max)
+    };
+    // DFSPH's implicit viscosity has no time-step limit (the artificial
+    // viscosities stay explicit).
+    let implicit_viscosity = sim.formulation == crate::scene::Formulation::Dfsph
+        && sim.dfsph.unwrap_or_default().viscosity == crate::scene::DfsphViscosity::Implicit;
+    let nu_max = fluid
+        .iter()
+        .filter(|_| !implicit_viscosity)
+        .map(|p| p.viscosity / p.rho0)
+        .fold(
+            interface_viscosity_nu(cx, sim, &fluid, dim, h, dx)?
+                + solid_fluid.map_or(0.0, |(a, _)| artificial_nu(a, &fluid, dim, h)),
+            f64::max,
+        );
+    let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
+    Ok(DtLimits {
+        acoustic: if c_max > 0.0 {
+            0.25 * h / c_max
+        } else {
+            f64::INFINITY
+        },
+        viscous: if nu_max > 0.0 {
+            0.125 * h * h / nu_max
+        } else {
+            f64::INFINITY
+        },
+        body_force: if g > 0.0 {
+            0.25 * (h / g).sqrt()
+        } else {
+            f64::INFINITY
+        },
+        conduction,
+        barrier: match barrier {
+            Some(b) => {
+                let m_min = fluid.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
+                0.22 * (m_min / b.stiffness).sqrt()
+            }
+            None => f64::INFINITY,
+        },
+        capillary: surface_tension.map_or(f64::INFINITY, |s| {
+            let rho = s.gas.map_or(phases[s.liquid].rho0, |g| {
+                phases[s.liquid].rho0.min(phases[g].rho0)
+            });
+            0.25 * (rho * h * h * h / (2.0 * std::f64::consts::PI * s.max_coefficient(phases)))
+                .sqrt()
+        }),
+        contact: bodies::contact_limit(bodies, phases, contact),
+        maximum: match scene.run.max_dt {
+            Some(_) if scene.run.dt.is_some() => {
+                return Err(cx.err("run.max_dt", "give dt (fixed) or max_dt (a cap), not both"));
+            }
+            Some(v) => cx.positive("run.max_dt", v)?,
+            None => f64::INFINITY,
+        },
+    })
+}
+
+/// What `validate` can predict will go wrong, as warnings: a liquid that
+/// disperses into its gas, a sound speed too low for the recoil, a metal melt
+/// that breaks up, a pressure floor on δ-SPH, J22's colour Laplacian.
+fn risk_warnings(
+    file: &str,
+    sim: &crate::scene::Simulation,
+    phases: &[PhaseInfo],
+    surface_tension: Option<&SurfaceTension>,
+    (dim, dx, h): (u32, f64, f64),
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if let Some(w) = dispersion_risk(file, sim, phases, surface_tension) {
+        warnings.push(w);
+    }
+    if let Some(w) = recoil_risk(file, phases) {
+        warnings.push(w);
+    }
+    if let Some(w) = breakup_risk(file, sim, phases, surface_tension, (dim, dx, h)) {
+        warnings.push(w);
+    }
+    if sim.formulation == Formulation::DeltaWcsph && sim.pressure_floor {
+        warnings.push(format!(
+            "{file}: key `simulation.pressure_floor`: on formulation = \"delta_wcsph\" the \
+             continuity density does not fall short at a free surface, and the floor takes \
+             away the tension that holds surface particles (a melting grain lost 2 particles \
+             and 8.5e-3 of its momentum with it, none and 9.4e-7 without); set it false"
+        ));
+    }
+    if surface_tension.is_some_and(|s| s.colour_laplacian) {
+        warnings.push(format!(
+            "{file}: key `surface_tension.model`: J22 (5)-(8) as printed holds no drop together \
+             at a free surface. On the Laplace disc (R = 20 dx) summation density (wcsph, dfsph) \
+             leaves the colour at 0.99 on the surface and no force (jump -99.997%); on \
+             delta_wcsph the outer row is pushed outward (-98.8%, 40 of 1264 particles blown \
+             off). It is here to reproduce J22; model = \"csf\" is the surface tension"
+        ));
+    }
+    warnings
+}
+
+/// `[run]`: a fixed step (within the stability limits unless `dt_check` is
+/// false), the end, the output and diagnostics intervals.
+fn run_timing(
+    cx: &Ctx,
+    run: &crate::scene::RunDef,
+    limits: &DtLimits,
+) -> Result<(Option<f64>, EndCondition, f64, f64), InputError> {
+    let fixed_dt = match run.dt {
+        Some(dt) => {
+            cx.positive("run.dt", dt)?;
+            let (lim, which) = limits.min();
+            if dt > lim && run.dt_check.unwrap_or(true) {
+                return Err(cx.err(
+                    "run.dt",
+                    format!(
+                        "fixed time step {dt:e} s exceeds the stability limit {lim:e} s ({which})"
+                    ),
+                ));
+            }
+            Some(dt)
+        }
+        None => None,
+    };
+    let end = match (run.end_time, run.steps) {
+        (Some(_), Some(_)) => return Err(cx.err("run", "give end_time or steps, not both")),
+        (Some(t), None) => EndCondition::Time(cx.positive("run.end_time", t)?),
+        (None, Some(n)) => EndCondition::Steps(n),
+        (None, None) => return Err(cx.err("run", "needs end_time or steps")),
+    };
+    let output_interval = match run.output_interval {
+        Some(v) => cx.positive("run.output_interval", v)?,
+        None => match end {
+            EndCondition::Time(t) => t / 20.0,
+            EndCondition::Steps(_) => f64::INFINITY,
+        },
+    };
+    let diagnostics_interval = match run.diagnostics_interval {
+        Some(v) => cx.positive("run.diagnostics_interval", v)?,
+        None => output_interval,
+    };
+    Ok((fixed_dt, end, output_interval, diagnostics_interval))
+}
+
+/// `[watchdog]`: the bounds an unstable run is stopped at.
+fn watchdog_inputs(cx: &Ctx, wd: &WatchdogDef) -> Result<(), InputError> {
+    cx.positive("watchdog.min_density_ratio", wd.min_density_ratio)?;
+    cx.positive("watchdog.min_dt_ratio", wd.min_dt_ratio)?;
+    if let Some(depth) = wd.wall_penetration {
+        cx.positive("watchdog.wall_penetration", depth)?;
+    }
+    if !(wd.liquid_dispersion > 0.0 && wd.liquid_dispersion <= 1.0) {
+        return Err(cx.err(
+            "watchdog.liquid_dispersion",
+            format!("must be a share in (0, 1] (got {})", wd.liquid_dispersion),
+        ));
+    }
+    if !(wd.max_density_ratio > 1.0 && wd.max_density_ratio.is_finite()) {
+        return Err(cx.err(
+            "watchdog.max_density_ratio",
+            format!(
+                "must be a finite number above 1 (got {})",
+                wd.max_density_ratio
+            ),
+        ));
+    }
+    if wd.min_density_ratio >= 1.0 {
+        return Err(cx.err(
+            "watchdog.min_density_ratio",
+            format!("must be below 1 (got {})", wd.min_density_ratio),
+        ));
+    }
+    Ok(())
 }
 
 /// `simulation.delta` (δ-SPH only): 0 ≤ δ ≤ 1.
@@ -1187,150 +1076,6 @@ fn barrier_def(
         stiffness: cx.positive("simulation.barrier.stiffness", b.stiffness)?,
         damping: cx.non_negative("simulation.barrier.damping", b.damping)?,
     }))
-}
-
-/// `binder` (F22 §4.2) measures a liquid in a rigid powder bed and judges at
-/// least one thing; its lengths are positive.
-fn binder_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
-    if !scene.powder.as_ref().is_some_and(|p| p.rigid) {
-        return Err(cx.err(
-            "check.kind",
-            "\"binder\" needs a [powder] bed of rigid grains (`rigid = true`)",
-        ));
-    }
-    if let Some(p) = c.penetration_below {
-        cx.positive("check.penetration_below", p)?;
-    }
-    if let Some(w) = c.spread_above {
-        cx.positive("check.spread_above", w)?;
-    }
-    if c.ejected == Some(0) {
-        return Err(cx.err(
-            "check.ejected",
-            "at least 1 (0 grains ejected is no criterion)",
-        ));
-    }
-    if c.penetration_below.is_none()
-        && c.spread_above.is_none()
-        && c.reaches_walls != Some(true)
-        && c.ejected.is_none()
-        && c.sinking != Some(true)
-    {
-        return Err(cx.err(
-            "check.kind",
-            "\"binder\" needs something to judge: check.penetration_below, check.spread_above, \
-             check.reaches_walls = true, check.ejected or check.sinking = true",
-        ));
-    }
-    Ok(())
-}
-
-/// `deposition` (F22 §4.4) follows the scene's shape bodies (the grains) into a
-/// laser's pool; its references are positive, a diameter comes with its time,
-/// and it judges at least one thing.
-fn deposition_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
-    if scene.laser.is_none() || !scene.shapes.iter().any(|s| s.body) {
-        return Err(cx.err(
-            "check.kind",
-            "\"deposition\" needs a [laser] and grains as shapes with `body = true`",
-        ));
-    }
-    if let Some(t) = c.arrival {
-        cx.positive("check.arrival", t)?;
-    }
-    if let Some(d) = c.diameter {
-        cx.positive("check.diameter", d)?;
-        cx.positive("check.diameter_time", c.diameter_time.unwrap_or(f64::NAN))?;
-    }
-    if let Some(tol) = c.diameter_tolerance {
-        cx.positive("check.diameter_tolerance", tol)?;
-    }
-    if c.arrival.is_none() && c.diameter.is_none() && c.unmolten != Some(true) {
-        return Err(cx.err(
-            "check.kind",
-            "\"deposition\" needs something to judge: check.arrival, check.diameter (with \
-             check.diameter_time) or check.unmolten = true",
-        ));
-    }
-    Ok(())
-}
-
-/// `point_melt` (F22 §4.5) reads the beam's switch-off, T_v and the plate's
-/// top: a laser whose power ends at 0 (`laser.power_until`), a material with
-/// `evaporation`, a solid phase that melts.
-fn point_melt_needs(cx: &Ctx, scene: &SceneFile, phases: &[PhaseInfo]) -> Result<(), InputError> {
-    if scene.laser.as_ref().and_then(|l| l.power_until).is_none() {
-        return Err(cx.err(
-            "laser.power_until",
-            "missing: \"point_melt\" judges the depression while the beam is on and the indentation after it goes off",
-        ));
-    }
-    if !phases
-        .iter()
-        .any(|p| p.thermal.is_some_and(|t| t.evaporation.is_some()))
-    {
-        return Err(cx.err(
-            "check.kind",
-            "\"point_melt\" needs a material with `evaporation` (its boiling_temperature is F22's T_v)",
-        ));
-    }
-    if !phases
-        .iter()
-        .any(|p| p.kind == PhaseKind::Solid && p.switch_to.is_some())
-    {
-        return Err(cx.err(
-            "check.kind",
-            "\"point_melt\" needs a solid phase that melts (the plate)",
-        ));
-    }
-    Ok(())
-}
-
-/// `check.kind = "thermocapillary"`: the channel the check's analytic solution
-/// describes. 2D, periodic in x, walls on y; F22's surface tension with α0' < 0;
-/// one Dirichlet wall phase with a temperature wave along x (the bottom) and one
-/// without (the top); `check.surface` (the interface height) inside the domain.
-fn thermocapillary_layout(
-    cx: &Ctx,
-    scene: &SceneFile,
-    dim: u32,
-    phases: &[PhaseInfo],
-    tension: Option<&SurfaceTension>,
-    c: &CheckDef,
-) -> Result<(), InputError> {
-    let bad = |msg: &str| Err(cx.err("check.kind", format!("\"thermocapillary\" needs {msg}")));
-    let d = &scene.domain;
-    if dim != 2
-        || !d.periodic.first().copied().unwrap_or(false)
-        || d.periodic.get(1).copied().unwrap_or(false)
-    {
-        return bad("a 2D scene periodic in x with walls on y");
-    }
-    if !tension.is_some_and(|t| t.gas.is_some() && t.slope < 0.0 && t.sahoo.is_none()) {
-        return bad("[surface_tension] with a gas phase and a negative temperature_coefficient");
-    }
-    let walls: Vec<&Thermal> = phases
-        .iter()
-        .filter(|p| p.kind == PhaseKind::Wall)
-        .filter_map(|p| p.thermal.as_ref())
-        .collect();
-    let waves = walls
-        .iter()
-        .filter(|t| t.wave.is_some_and(|w| w.axis == 0))
-        .count();
-    if waves != 1 || walls.len() != 2 {
-        return bad(
-            "two Dirichlet wall phases, one with a temperature_wave along x (the y_min wall)",
-        );
-    }
-    let y = c.surface.unwrap_or(f64::NAN);
-    if !(y > d.min[1] && y < d.max[1]) {
-        return Err(cx.err(
-            "check.surface",
-            format!("the interface height must lie inside the domain's y range, got {y}"),
-        ));
-    }
-    Ok(())
 }
 
 /// `simulation.dfsph` and what DFSPH does not take yet.

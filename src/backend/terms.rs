@@ -47,7 +47,23 @@ pub enum Sum {
     Heating,
 }
 
+/// A pair term, by its place in `PAIR_TERMS` (a test holds the two in step):
+/// code asks for a term by id, so a misspelt term does not compile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TermId {
+    Pressure = 0,
+    Viscosity = 1,
+    ShepardPressure = 2,
+    MarroneViscosity = 3,
+    BackgroundPressure = 4,
+    InterfaceViscosity = 5,
+    SolidFluidViscosity = 6,
+    ViscousHeating = 7,
+    Barrier = 8,
+}
+
 pub struct PairTerm {
+    pub id: TermId,
     pub name: &'static str,
     /// The pass whose sweep calls it (and whose WGSL gets its file appended).
     pub pass: &'static str,
@@ -59,11 +75,12 @@ pub struct PairTerm {
     pub acts: Acts,
     pub sum: Sum,
     /// Terms whose WGSL functions this one's file calls (carried with it).
-    pub needs: &'static [&'static str],
+    pub needs: &'static [TermId],
 }
 
 pub const PAIR_TERMS: [PairTerm; 9] = [
     PairTerm {
+        id: TermId::Pressure,
         name: "pressure",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/pressure.wgsl"),
@@ -74,6 +91,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::Viscosity,
         name: "viscosity",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/viscosity.wgsl"),
@@ -84,6 +102,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::ShepardPressure,
         name: "shepard_pressure",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/shepard_pressure.wgsl"),
@@ -94,6 +113,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::MarroneViscosity,
         name: "marrone_viscosity",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/marrone_viscosity.wgsl"),
@@ -104,6 +124,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::BackgroundPressure,
         name: "background_pressure",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/background_pressure.wgsl"),
@@ -114,6 +135,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::InterfaceViscosity,
         name: "interface_viscosity",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/interface_viscosity.wgsl"),
@@ -124,6 +146,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::SolidFluidViscosity,
         name: "solid_fluid_viscosity",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/solid_fluid_viscosity.wgsl"),
@@ -131,9 +154,10 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         active: |p| p.flow.solid_fluid_viscosity > 0.0,
         acts: SOLIDS,
         sum: Sum::Force,
-        needs: &["interface_viscosity"],
+        needs: &[TermId::InterfaceViscosity],
     },
     PairTerm {
+        id: TermId::ViscousHeating,
         name: "viscous_heating",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/viscous_heating.wgsl"),
@@ -144,6 +168,7 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
         needs: &[],
     },
     PairTerm {
+        id: TermId::Barrier,
         name: "barrier",
         pass: "forces",
         wgsl: include_str!("../../shaders/terms/barrier.wgsl"),
@@ -155,13 +180,9 @@ pub const PAIR_TERMS: [PairTerm; 9] = [
     },
 ];
 
-/// Whether the scene uses the term `name`.
-pub fn active(params: &Params, name: &str) -> bool {
-    let t = PAIR_TERMS
-        .iter()
-        .find(|t| t.name == name)
-        .unwrap_or_else(|| panic!("no pair term {name}"));
-    (t.active)(params)
+/// Whether the scene uses the term `id`.
+pub fn active(params: &Params, id: TermId) -> bool {
+    (PAIR_TERMS[id as usize].active)(params)
 }
 
 /// The pass that evaluates the fluid's reaction on body particles (F22 (38),
@@ -180,18 +201,18 @@ pub fn reaction_terms() -> impl Iterator<Item = &'static PairTerm> {
 /// bodies pass, or a term one of those needs.
 /// Passes outside a term's sweep that call its WGSL functions (DFSPH's
 /// implicit viscosity takes the viscous term's pair mean).
-const BORROWED: [(&str, &str); 1] = [("dfsph_viscosity", "viscosity")];
+const BORROWED: [(&str, TermId); 1] = [("dfsph_viscosity", TermId::Viscosity)];
 
 fn carried(pass: &str, t: &PairTerm) -> bool {
     let direct = |u: &PairTerm| {
         u.pass == pass
-            || (pass == REACTION_PASS && reaction_terms().any(|r| r.name == u.name))
-            || BORROWED.contains(&(pass, u.name))
+            || (pass == REACTION_PASS && reaction_terms().any(|r| r.id == u.id))
+            || BORROWED.contains(&(pass, u.id))
     };
     direct(t)
         || PAIR_TERMS
             .iter()
-            .any(|u| direct(u) && u.needs.contains(&t.name))
+            .any(|u| direct(u) && u.needs.contains(&t.id))
 }
 
 /// The pass's term sources, in registry order (appended to the pass's WGSL).
@@ -261,6 +282,14 @@ mod tests {
                 .unwrap_or_else(|| panic!("cpu/bodies.rs: {}", t.name));
             assert!(w > last.0 && r > last.1, "{} out of order", t.name);
             last = (w, r);
+        }
+    }
+
+    /// Each row sits at its id's place, so `active` reads the right row.
+    #[test]
+    fn each_term_sits_at_its_id() {
+        for (k, t) in PAIR_TERMS.iter().enumerate() {
+            assert_eq!(t.id as usize, k, "{}", t.name);
         }
     }
 

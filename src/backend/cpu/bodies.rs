@@ -197,10 +197,11 @@ pub fn forces(pr: &Params, st: &mut State, grid: &CellTable) {
     let (rho, press, mass, vel) = (&st.rho, &st.press, &st.mass, &st.vel);
     let bp = &pr.bodies;
     let reach2 = bp.contact_distance * bp.contact_distance;
-    let sf = crate::backend::terms::active(pr, "solid_fluid_viscosity");
-    let br = crate::backend::terms::active(pr, "barrier");
-    let df = crate::backend::terms::active(pr, "shepard_pressure");
-    let marrone = crate::backend::terms::active(pr, "marrone_viscosity");
+    let sf = crate::backend::terms::active(pr, crate::backend::terms::TermId::SolidFluidViscosity);
+    let br = crate::backend::terms::active(pr, crate::backend::terms::TermId::Barrier);
+    let df = crate::backend::terms::active(pr, crate::backend::terms::TermId::ShepardPressure);
+    let marrone =
+        crate::backend::terms::active(pr, crate::backend::terms::TermId::MarroneViscosity);
     let (heat, cont) = (&st.heat, &st.continuity);
     st.acc[..n].par_iter_mut().enumerate().for_each(|(i, a)| {
         let k = body[id[i] as usize];

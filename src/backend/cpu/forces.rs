@@ -14,7 +14,7 @@
 
 use super::neighbors::{for_each_listed, CellTable, NeighborList};
 use super::terms;
-use crate::backend::terms::active;
+use crate::backend::terms::{active, TermId};
 use crate::kernel;
 use crate::model::MAX_PHASES;
 use crate::params::{Params, KIND_WALL, PHASE_FREE_SLIP};
@@ -51,13 +51,13 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
 /// `run` one neighbour at a time, whatever the CPU and scene.
 pub(super) fn scalar(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborList) {
     monomorphise!(sweep::<>(pr, st, grid, list); [
-        active(pr, "background_pressure"),
-        active(pr, "interface_viscosity"),
-        active(pr, "solid_fluid_viscosity"),
-        active(pr, "viscous_heating"),
-        active(pr, "barrier"),
+        active(pr, TermId::BackgroundPressure),
+        active(pr, TermId::InterfaceViscosity),
+        active(pr, TermId::SolidFluidViscosity),
+        active(pr, TermId::ViscousHeating),
+        active(pr, TermId::Barrier),
         // delta_wcsph: R18's pressure (and the option of its viscosity).
-        active(pr, "shepard_pressure")
+        active(pr, TermId::ShepardPressure)
     ])
 }
 
@@ -88,7 +88,7 @@ fn sweep<
     let eta_pair = PairViscosity::new(pr);
     // R18 (3.18) in place of F22's viscous term: a δ-SPH option (DF), tested per
     // pair only in the δ sweeps.
-    let marrone = active(pr, "marrone_viscosity");
+    let marrone = active(pr, TermId::MarroneViscosity);
     let vol: Vec<f32> = mass.par_iter().zip(rho).map(|(m, r)| m / r).collect();
     let (acc, acc_b) = (&mut st.acc[..n], &mut st.acc_b[..n]);
     accelerations(pr, phase, mass, acc, acc_b, |i| {

@@ -19,7 +19,7 @@
 use super::forces::{accelerations, Sums};
 use super::neighbors::{with_listed, CellTable, NeighborList};
 use super::terms;
-use crate::backend::terms::{active, PAIR_TERMS};
+use crate::backend::terms::{active, TermId, PAIR_TERMS};
 use crate::kernel;
 use crate::lanes::{Lane, AVX2, F8};
 use crate::model::MAX_PHASES;
@@ -30,13 +30,18 @@ use std::arch::x86_64::*;
 
 /// The forces-pass terms this sweep evaluates. A scene using any other term
 /// (a new one included, until it is added here and below) takes the scalar sweep.
-const TERMS: [&str; 4] = ["pressure", "viscosity", "background_pressure", "barrier"];
+const TERMS: [TermId; 4] = [
+    TermId::Pressure,
+    TermId::Viscosity,
+    TermId::BackgroundPressure,
+    TermId::Barrier,
+];
 
 /// Whether this scene's forces pass can run eight-wide on this CPU.
 pub fn applies(pr: &Params) -> bool {
     let others = PAIR_TERMS
         .iter()
-        .filter(|t| t.pass == "forces" && !TERMS.contains(&t.name))
+        .filter(|t| t.pass == "forces" && !TERMS.contains(&t.id))
         .any(|t| (t.active)(pr));
     *AVX2 && pr.sizes.flags & 7 == 0 && !others
 }
@@ -53,7 +58,10 @@ pub fn run(
     eta: &[[f32; MAX_PHASES]; MAX_PHASES],
 ) {
     assert!(*AVX2, "the eight-wide forces sweep needs AVX2 (`applies`)");
-    let (bg, br) = (active(pr, "background_pressure"), active(pr, "barrier"));
+    let (bg, br) = (
+        active(pr, TermId::BackgroundPressure),
+        active(pr, TermId::Barrier),
+    );
     // Each phase's wall velocity (the barrier's U_wall), one table per axis.
     let wall_velocity: [[f32; MAX_PHASES]; 3] =
         std::array::from_fn(|a| std::array::from_fn(|ph| pr.phases[ph].velocity[a]));
@@ -330,7 +338,7 @@ mod tests {
         let mut list = NeighborList::default();
         density::run(&pr, &mut st, &grid, &mut list);
         wall::run(&pr, &mut st, &grid);
-        assert!(applies(&pr) && active(&pr, "barrier"));
+        assert!(applies(&pr) && active(&pr, TermId::Barrier));
         let barrier_pairs = barrier_pairs(&pr, &st, &grid, &list);
         assert!(barrier_pairs > 0, "the barrier is never in play");
         for background in [0.0, 2.5e3] {

@@ -88,7 +88,7 @@ fn drop_contact_scenes_validate() {
             "validate",
             &common::scene("laplace_free_disc_2d"),
             "--set",
-            "check.kind=\"drop_contact\"",
+            "check={ kind = \"drop_contact\", tolerance = 0.5 }",
         ],
         "check.kind",
     );

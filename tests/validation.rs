@@ -367,7 +367,7 @@ fn compression_check_matches_hydrostatic_column() {
     let c = run_check(
         "hydrostatic_2d",
         &[
-            "check.kind=compression",
+            "check={ kind = \"compression\", tolerance = 0.02 }",
             "simulation.initial_pressure=hydrostatic",
             "run.end_time=0.3",
         ],

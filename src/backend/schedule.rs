@@ -7,7 +7,7 @@
 //! loop returns at once after reading the flag, on the CPU the twins read the
 //! same flag (and the loop stops early, which gives the same state).
 //!
-//! Adding a formulation: a `Formulation` variant (scene.rs), its row in
+//! Adding a formulation: a `Formulation` variant (scene/mod.rs), its row in
 //! `FORMULATIONS` with the function that lists its nodes, and its stages' rows
 //! in passes.rs.
 

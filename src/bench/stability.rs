@@ -508,7 +508,7 @@ fn enthalpy(m: &Model, st: &State) -> f64 {
 fn conserves(c: &Case, m: &Model) -> Conserves {
     c.conserves.unwrap_or(Conserves {
         momentum: false,
-        enthalpy: m.check.as_ref().map(|k| k.kind) == Some(CheckKind::Adiabatic),
+        enthalpy: m.check.as_ref().map(|k| k.kind()) == Some(CheckKind::Adiabatic),
     })
 }
 

@@ -40,7 +40,7 @@ pub struct Binder {
 }
 
 impl Binder {
-    pub fn new(c: &crate::scene::CheckDef) -> Binder {
+    pub fn new(c: &crate::scene::BinderCheck) -> Binder {
         Binder {
             penetration_below: c.penetration_below,
             spread_above: c.spread_above,

@@ -45,7 +45,7 @@ pub struct Deposition {
 }
 
 impl Deposition {
-    pub fn new(c: &crate::scene::CheckDef) -> Deposition {
+    pub fn new(c: &crate::scene::DepositionCheck) -> Deposition {
         Deposition {
             arrival: c.arrival,
             diameter: c.diameter.map(|d| {

@@ -16,7 +16,7 @@
 
 use super::{Check, Series, Verdict};
 use crate::model::Model;
-use crate::scene::{CheckDef, MeasuredTrackDef};
+use crate::scene::MeasuredTrackDef;
 use crate::state::State;
 use crate::track::Track;
 
@@ -28,9 +28,9 @@ pub struct MeasuredTrack {
 }
 
 impl MeasuredTrack {
-    pub fn new(c: &CheckDef) -> MeasuredTrack {
+    pub fn new(measured: &MeasuredTrackDef) -> MeasuredTrack {
         MeasuredTrack {
-            def: c.measured.clone().expect("validated: [check.measured]"),
+            def: measured.clone(),
             track: None,
             samples: Vec::new(),
         }

@@ -152,8 +152,8 @@ pub struct Checker {
 impl Checker {
     pub fn new(m: &Model) -> Option<Checker> {
         m.check.as_ref().map(|c| Checker {
-            kind: c.kind,
-            tolerance: c.tolerance,
+            kind: c.kind(),
+            tolerance: c.tolerance(),
             check: make(m, c),
         })
     }
@@ -183,65 +183,59 @@ impl Checker {
     }
 }
 
-/// The check a `[check]` section asks for.
+/// The check a `[check]` section asks for, built from its kind's keys.
 fn make(m: &Model, c: &CheckDef) -> Box<dyn Check> {
-    match c.kind {
-        CheckKind::Hydrostatic => Box::new(flow::Hydrostatic {
-            surface: c.surface.unwrap_or(f64::NAN),
-            exclude: c.exclude_depth.unwrap_or(3.0 * m.h),
+    use CheckDef as D;
+    match c {
+        D::Hydrostatic(d) => Box::new(flow::Hydrostatic {
+            surface: d.surface,
+            exclude: d.exclude_depth.unwrap_or(3.0 * m.h),
         }),
-        CheckKind::Poiseuille => Box::new(flow::Profile::Poiseuille),
-        CheckKind::Couette => Box::new(flow::Profile::Couette),
-        CheckKind::DamBreakFront => Box::new(dam_break::DamBreak::new(
-            c.column_width.unwrap_or(f64::NAN),
-            c.experiment,
-        )),
-        CheckKind::TwoLayer => Box::new(two_layer::TwoLayer::default()),
-        CheckKind::Compression => Box::new(compression::Compression::default()),
-        CheckKind::Laplace => Box::new(tension::Laplace::new(m, c)),
-        CheckKind::RecoilImpulse => Box::new(tension::RecoilImpulse::new(c)),
-        CheckKind::DropShape => Box::new(tension::DropShape::default()),
-        CheckKind::ContactAngle => Box::new(tension::ContactAngle::default()),
-        CheckKind::Thermocapillary => Box::new(thermocapillary::Thermocapillary::new(c)),
-        CheckKind::Conduction1d => Box::new(heat::Conduction1d),
-        CheckKind::ConductionTwoMaterials => Box::new(heat::TwoMaterials {
-            interface: c.surface.unwrap_or(f64::NAN),
+        D::Poiseuille(_) => Box::new(flow::Profile::Poiseuille),
+        D::Couette(_) => Box::new(flow::Profile::Couette),
+        D::DamBreakFront(d) => Box::new(dam_break::DamBreak::new(d.column_width, d.experiment)),
+        D::TwoLayer(_) => Box::new(two_layer::TwoLayer::default()),
+        D::Compression(_) => Box::new(compression::Compression::default()),
+        D::Laplace(d) => Box::new(tension::Laplace::new(m, d)),
+        D::RecoilImpulse(d) => Box::new(tension::RecoilImpulse::new(d.area)),
+        D::DropShape(_) => Box::new(tension::DropShape::default()),
+        D::ContactAngle(_) => Box::new(tension::ContactAngle::default()),
+        D::Thermocapillary(d) => Box::new(thermocapillary::Thermocapillary::new(d.surface)),
+        D::Conduction1d(_) => Box::new(heat::Conduction1d),
+        D::ConductionTwoMaterials(d) => Box::new(heat::TwoMaterials {
+            interface: d.surface,
         }),
-        CheckKind::Adiabatic => Box::new(heat::Adiabatic::default()),
-        CheckKind::Stefan1d => Box::new(heat::Stefan::default()),
-        CheckKind::SolidificationFront => Box::new(solidification::Front),
-        CheckKind::Rosenthal => Box::new(heat::Rosenthal),
-        CheckKind::LaserEnergy => Box::new(heat::LaserEnergy::default()),
-        CheckKind::Restitution => Box::new(bodies::Restitution),
-        CheckKind::Flotation => Box::new(bodies::Flotation),
-        CheckKind::BedAtRest => Box::new(bodies::AtRest::new(c.settle_time)),
-        CheckKind::MeltingGrain => Box::new(bodies::MeltingGrain::default()),
-        CheckKind::Settling => Box::new(bodies::Settling::new(c.settle_time)),
-        CheckKind::ThermalExpansion => Box::new(expansion::ThermalExpansion::new(
-            c.settle_time,
-            c.band_tolerance,
-            c.tolerance,
+        D::Adiabatic(_) => Box::new(heat::Adiabatic::default()),
+        D::Stefan1d(_) => Box::new(heat::Stefan::default()),
+        D::SolidificationFront(_) => Box::new(solidification::Front),
+        D::Rosenthal(_) => Box::new(heat::Rosenthal),
+        D::LaserEnergy(_) => Box::new(heat::LaserEnergy::default()),
+        D::Restitution(_) => Box::new(bodies::Restitution),
+        D::Flotation(_) => Box::new(bodies::Flotation),
+        D::BedAtRest(d) => Box::new(bodies::AtRest::new(d.settle_time)),
+        D::MeltingGrain(_) => Box::new(bodies::MeltingGrain::default()),
+        D::Settling(d) => Box::new(bodies::Settling::new(d.settle_time)),
+        D::ThermalExpansion(d) => Box::new(expansion::ThermalExpansion::new(
+            d.settle_time,
+            d.band_tolerance,
+            d.tolerance,
         )),
-        CheckKind::RisingAmplitude => Box::new(expansion::RisingAmplitude::new(
-            c.settle_time,
-            c.swing.unwrap_or(0.41),
+        D::RisingAmplitude(d) => Box::new(expansion::RisingAmplitude::new(
+            d.settle_time,
+            d.swing.unwrap_or(0.41),
         )),
-        CheckKind::ColumnExpansion => {
-            Box::new(expansion::ColumnExpansion::new(c.area.unwrap_or(f64::NAN)))
-        }
-        CheckKind::PressureNoise => Box::new(noise::PressureNoise::new(c.settle_time)),
-        CheckKind::R18Track => Box::new(track::R18Track::new(c.surface, c.r18_slice_depth)),
-        CheckKind::Splat => Box::new(splat::Splat::new(m, c.phase.as_deref(), c.spread_factor)),
-        CheckKind::ImpactForce => Box::new(impact::ImpactForce::new(m, c.phase.as_deref())),
-        CheckKind::Remelt => Box::new(remelt::Remelt::new(c.depth)),
-        CheckKind::DropContact => Box::new(drops::DropContact::new(c.fraction)),
-        CheckKind::PointMelt => Box::new(point_melt::PointMelt::new()),
-        CheckKind::Deposition => Box::new(deposition::Deposition::new(c)),
-        CheckKind::Binder => Box::new(binder::Binder::new(c)),
-        CheckKind::MeasuredTrack => Box::new(measured_track::MeasuredTrack::new(c)),
-        CheckKind::FreeRotation => Box::new(bodies::FreeRotation::new(
-            c.energy_tolerance.unwrap_or(f64::NAN),
-        )),
+        D::ColumnExpansion(d) => Box::new(expansion::ColumnExpansion::new(d.area)),
+        D::PressureNoise(d) => Box::new(noise::PressureNoise::new(d.settle_time)),
+        D::R18Track(d) => Box::new(track::R18Track::new(d.surface, d.r18_slice_depth)),
+        D::Splat(d) => Box::new(splat::Splat::new(m, d.phase.as_deref(), d.spread_factor)),
+        D::ImpactForce(d) => Box::new(impact::ImpactForce::new(m, d.phase.as_deref())),
+        D::Remelt(d) => Box::new(remelt::Remelt::new(d.depth)),
+        D::DropContact(d) => Box::new(drops::DropContact::new(d.fraction)),
+        D::PointMelt(_) => Box::new(point_melt::PointMelt::new()),
+        D::Deposition(d) => Box::new(deposition::Deposition::new(d)),
+        D::Binder(d) => Box::new(binder::Binder::new(d)),
+        D::MeasuredTrack(d) => Box::new(measured_track::MeasuredTrack::new(&d.measured)),
+        D::FreeRotation(d) => Box::new(bodies::FreeRotation::new(d.energy_tolerance)),
     }
 }
 

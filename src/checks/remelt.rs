@@ -26,9 +26,9 @@ pub struct Remelt {
 }
 
 impl Remelt {
-    pub fn new(reference: Option<f64>) -> Remelt {
+    pub fn new(reference: f64) -> Remelt {
         Remelt {
-            reference: reference.unwrap_or(f64::NAN),
+            reference,
             substrate: None,
             samples: Vec::new(),
         }

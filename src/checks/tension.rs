@@ -2,7 +2,7 @@
 
 use super::{particles, Check, Verdict};
 use crate::model::Model;
-use crate::scene::{CheckDef, PhaseKind};
+use crate::scene::{LaplaceCheck, PhaseKind};
 use crate::state::State;
 
 /// Laplace pressure of a drop at rest: the mean pressure of the liquid more than
@@ -25,14 +25,14 @@ struct Sample {
 }
 
 impl Laplace {
-    pub fn new(m: &Model, c: &CheckDef) -> Laplace {
+    pub fn new(m: &Model, c: &LaplaceCheck) -> Laplace {
         let mut center = [0.0; 3];
-        for (a, x) in c.center.iter().flatten().enumerate().take(m.dim as usize) {
+        for (a, x) in c.center.iter().enumerate().take(m.dim as usize) {
             center[a] = *x;
         }
         Laplace {
             center,
-            radius: c.radius.unwrap_or(f64::NAN),
+            radius: c.radius,
             samples: Vec::new(),
         }
     }
@@ -148,9 +148,9 @@ pub struct RecoilImpulse {
 }
 
 impl RecoilImpulse {
-    pub fn new(c: &CheckDef) -> RecoilImpulse {
+    pub fn new(area: f64) -> RecoilImpulse {
         RecoilImpulse {
-            area: c.area.unwrap_or(f64::NAN),
+            area,
             samples: Vec::new(),
         }
     }

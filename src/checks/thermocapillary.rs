@@ -23,7 +23,7 @@
 
 use super::{particles, Check, Verdict};
 use crate::model::Model;
-use crate::scene::{CheckDef, PhaseKind};
+use crate::scene::PhaseKind;
 use crate::state::State;
 use std::f64::consts::TAU;
 
@@ -236,9 +236,9 @@ pub struct Thermocapillary {
 }
 
 impl Thermocapillary {
-    pub fn new(c: &CheckDef) -> Thermocapillary {
+    pub fn new(surface: f64) -> Thermocapillary {
         Thermocapillary {
-            surface: c.surface.unwrap_or(f64::NAN),
+            surface,
             samples: Vec::new(),
         }
     }

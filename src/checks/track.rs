@@ -35,10 +35,10 @@ pub struct R18Track {
 }
 
 impl R18Track {
-    pub fn new(surface: Option<f64>, slice_depth: Option<f64>) -> R18Track {
+    pub fn new(surface: f64, slice_depth: f64) -> R18Track {
         R18Track {
-            surface: surface.unwrap_or(f64::NAN),
-            slice_depth: slice_depth.unwrap_or(f64::NAN),
+            surface,
+            slice_depth,
             penetration: 0.0,
         }
     }

@@ -2,7 +2,7 @@
 //! before anything runs (the verdicts themselves are in crate::checks).
 
 use super::*;
-use crate::scene::CheckKind;
+use crate::scene::{BinderCheck, CheckKind, DepositionCheck};
 
 /// What the scene around a check must give it: the parts of the model the
 /// check kinds read.
@@ -20,37 +20,65 @@ pub(super) fn validate(
     c: &CheckDef,
     at: &Around,
 ) -> Result<(), InputError> {
-    use CheckKind as K;
+    use CheckDef as D;
     let (dim, phases) = (at.dim, at.phases);
-    cx.positive("check.tolerance", c.tolerance)?;
-    if let Some(b) = c.band_tolerance {
-        cx.positive("check.band_tolerance", b)?;
-    }
-    if let Some(s) = c.swing {
-        cx.positive("check.swing", s)?;
-    }
-    reference_needs(cx, scene, c, phases)?;
-    match c.kind {
-        K::RecoilImpulse => {
-            cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
-        }
-        K::ThermalExpansion | K::RisingAmplitude | K::ColumnExpansion => {
-            if c.kind == K::ColumnExpansion {
-                cx.positive("check.area", c.area.unwrap_or(f64::NAN))?;
-            }
-            if !phases.iter().any(|p| p.density_law.is_some()) {
-                return Err(cx.err(
-                    "check.kind",
-                    "the expansion checks need a liquid with a density law (materials.<m>.density_law)",
-                ));
+    cx.positive("check.tolerance", c.tolerance())?;
+    reference_needs(cx, scene, c.kind(), phases)?;
+    match c {
+        D::Hydrostatic(d) => {
+            finite(cx, "check.surface", d.surface)?;
+            if let Some(e) = d.exclude_depth {
+                cx.positive("check.exclude_depth", e)?;
             }
         }
-        K::DropShape | K::ContactAngle | K::Laplace => tension_needs(cx, c, at)?,
-        K::Thermocapillary => {
-            thermocapillary_layout(cx, scene, dim, phases, at.surface_tension, c)?
+        D::DamBreakFront(d) => {
+            cx.positive("check.column_width", d.column_width)?;
         }
-        K::Splat | K::ImpactForce => droplet_needs(cx, c, dim, phases)?,
-        K::DropContact
+        D::FreeRotation(d) => {
+            cx.positive("check.energy_tolerance", d.energy_tolerance)?;
+        }
+        D::RecoilImpulse(d) => {
+            cx.positive("check.area", d.area)?;
+        }
+        D::ThermalExpansion(d) => {
+            if let Some(b) = d.band_tolerance {
+                cx.positive("check.band_tolerance", b)?;
+            }
+            density_law_needed(cx, phases)?;
+        }
+        D::RisingAmplitude(d) => {
+            if let Some(s) = d.swing {
+                cx.positive("check.swing", s)?;
+            }
+            density_law_needed(cx, phases)?;
+        }
+        D::ColumnExpansion(d) => {
+            cx.positive("check.area", d.area)?;
+            density_law_needed(cx, phases)?;
+        }
+        D::DropShape(_) | D::ContactAngle(_) => tension_needs(cx, c.kind(), at)?,
+        D::Laplace(d) => {
+            cx.vector("check.center", &d.center, dim)?;
+            cx.positive("check.radius", d.radius)?;
+            tension_needs(cx, c.kind(), at)?;
+        }
+        D::Thermocapillary(d) => {
+            thermocapillary_layout(cx, scene, dim, phases, at.surface_tension, d.surface)?
+        }
+        D::ConductionTwoMaterials(d) => finite(cx, "check.surface", d.surface)?,
+        D::Splat(d) => {
+            if let Some(xi) = d.spread_factor {
+                if !(xi.is_finite() && xi >= 1.0) {
+                    return Err(cx.err(
+                        "check.spread_factor",
+                        format!("a spread factor D/D0 is at least 1, got {xi}"),
+                    ));
+                }
+            }
+            droplet_needs(cx, c.kind(), d.phase.as_deref(), dim, phases)?
+        }
+        D::ImpactForce(d) => droplet_needs(cx, c.kind(), d.phase.as_deref(), dim, phases)?,
+        D::DropContact(_)
             if !phases.iter().any(|p| {
                 p.kind == PhaseKind::Liquid && p.thermal.is_some_and(|t| t.melting.is_some())
             }) =>
@@ -60,9 +88,8 @@ pub(super) fn validate(
                 "\"drop_contact\" needs liquid drops whose material melts (solidus, liquidus)",
             ));
         }
-        K::Remelt => {
-            let d = c.depth.unwrap_or(f64::NAN);
-            if !(d.is_finite() && d >= 0.0) {
+        D::Remelt(d) => {
+            if !(d.depth.is_finite() && d.depth >= 0.0) {
                 return Err(cx.err(
                     "check.depth",
                     "\"remelt\" needs the reference depth (m, >= 0)",
@@ -75,30 +102,18 @@ pub(super) fn validate(
                 return Err(cx.err("check.kind", "\"remelt\" needs a solid phase that melts"));
             }
         }
-        K::PointMelt => point_melt_needs(cx, scene, phases)?,
-        K::Deposition => deposition_needs(cx, scene, c)?,
-        K::Binder => binder_needs(cx, scene, c)?,
-        K::MeasuredTrack => {
-            match (&c.measured, &scene.laser) {
-                (Some(d), Some(_)) => d.validate(cx.file, dim)?,
-                (None, _) => return Err(cx.err(
-                    "check.measured",
-                    "missing: measured_track needs [check.measured] (width, depth, length, steady)",
-                )),
-                (_, None) => return Err(cx.err("check.kind", "\"measured_track\" needs a [laser]")),
+        D::PointMelt(_) => point_melt_needs(cx, scene, phases)?,
+        D::Deposition(d) => deposition_needs(cx, scene, d)?,
+        D::Binder(d) => binder_needs(cx, scene, d)?,
+        D::MeasuredTrack(d) => {
+            if scene.laser.is_none() {
+                return Err(cx.err("check.kind", "\"measured_track\" needs a [laser]"));
             }
+            d.measured.validate(cx.file, dim)?
         }
-        K::R18Track => {
-            cx.positive(
-                "check.r18_slice_depth",
-                c.r18_slice_depth.unwrap_or(f64::NAN),
-            )?;
-            if !c.surface.is_some_and(f64::is_finite) {
-                return Err(cx.err(
-                    "check.surface",
-                    "\"r18_track\" needs the plate's initial top (m)",
-                ));
-            }
+        D::R18Track(d) => {
+            cx.positive("check.r18_slice_depth", d.r18_slice_depth)?;
+            finite(cx, "check.surface", d.surface)?;
             if !at.has_laser || dim != 2 {
                 return Err(cx.err(
                     "check.kind",
@@ -111,12 +126,33 @@ pub(super) fn validate(
     Ok(())
 }
 
+/// A height or position that must be a number (m).
+fn finite(cx: &Ctx, key: &str, v: f64) -> Result<(), InputError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(cx.err(key, format!("must be a finite length in m, got {v}")))
+    }
+}
+
+/// The expansion checks compare with a density law ρ0(T).
+fn density_law_needed(cx: &Ctx, phases: &[PhaseInfo]) -> Result<(), InputError> {
+    if phases.iter().any(|p| p.density_law.is_some()) {
+        Ok(())
+    } else {
+        Err(cx.err(
+            "check.kind",
+            "the expansion checks need a liquid with a density law (materials.<m>.density_law)",
+        ))
+    }
+}
+
 /// The checks against a closed-form reference: a fixed absorptivity (not
 /// ray-traced), constant properties (no varying table).
 fn reference_needs(
     cx: &Ctx,
     scene: &SceneFile,
-    c: &CheckDef,
+    kind: CheckKind,
     phases: &[PhaseInfo],
 ) -> Result<(), InputError> {
     use CheckKind as K;
@@ -124,18 +160,18 @@ fn reference_needs(
         .laser
         .as_ref()
         .is_some_and(|l| l.model == crate::scene::LaserModel::RayTraced);
-    if traced && matches!(c.kind, K::Rosenthal | K::LaserEnergy) {
+    if traced && matches!(kind, K::Rosenthal | K::LaserEnergy) {
         return Err(cx.err(
             "check.kind",
             format!(
                 "\"{}\" compares with a fixed absorptivity ζ: not with \
                  laser.model = \"ray_traced\"",
-                c.kind.name()
+                kind.name()
             ),
         ));
     }
     let constant_reference = matches!(
-        c.kind,
+        kind,
         K::Conduction1d
             | K::ConductionTwoMaterials
             | K::Stefan1d
@@ -158,7 +194,7 @@ fn reference_needs(
             format!(
                 "\"{}\"'s reference solution takes constant properties: not with a \
                  varying enthalpy_table or conductivity_table",
-                c.kind.name()
+                kind.name()
             ),
         ));
     }
@@ -167,9 +203,9 @@ fn reference_needs(
 
 /// The surface-tension checks: a 2D drop's shape or contact angle, a drop's
 /// Laplace jump.
-fn tension_needs(cx: &Ctx, c: &CheckDef, at: &Around) -> Result<(), InputError> {
+fn tension_needs(cx: &Ctx, kind: CheckKind, at: &Around) -> Result<(), InputError> {
     let st = at.surface_tension;
-    match c.kind {
+    match kind {
         CheckKind::DropShape => {
             if at.dim != 2 || !st.is_some_and(|s| s.is_constant()) {
                 return Err(cx.err(
@@ -187,8 +223,6 @@ fn tension_needs(cx: &Ctx, c: &CheckDef, at: &Around) -> Result<(), InputError> 
             }
         }
         _ => {
-            cx.vector("check.center", c.center.as_deref().unwrap_or(&[]), at.dim)?;
-            cx.positive("check.radius", c.radius.unwrap_or(f64::NAN))?;
             if !st.is_some_and(|s| s.is_constant()) {
                 return Err(cx.err(
                     "check.kind",
@@ -201,18 +235,24 @@ fn tension_needs(cx: &Ctx, c: &CheckDef, at: &Around) -> Result<(), InputError> 
 }
 
 /// The droplet checks (`splat`, `impact_force`): the droplet's phase, named
-/// where there are several liquids; a spread factor of at least one.
-fn droplet_needs(cx: &Ctx, c: &CheckDef, dim: u32, phases: &[PhaseInfo]) -> Result<(), InputError> {
-    if c.kind == CheckKind::ImpactForce && dim != 3 {
+/// where there are several liquids.
+fn droplet_needs(
+    cx: &Ctx,
+    kind: CheckKind,
+    phase: Option<&str>,
+    dim: u32,
+    phases: &[PhaseInfo],
+) -> Result<(), InputError> {
+    if kind == CheckKind::ImpactForce && dim != 3 {
         return Err(cx.err(
             "check.kind",
             "\"impact_force\" needs a 3D scene (its reference, 0.8 rho V^2 D^2, is a sphere's)",
         ));
     }
-    if let Some(name) = &c.phase {
+    if let Some(name) = phase {
         if !phases
             .iter()
-            .any(|p| &p.name == name && p.kind == PhaseKind::Liquid)
+            .any(|p| p.name == name && p.kind == PhaseKind::Liquid)
         {
             return Err(cx.err(
                 "check.phase",
@@ -220,24 +260,16 @@ fn droplet_needs(cx: &Ctx, c: &CheckDef, dim: u32, phases: &[PhaseInfo]) -> Resu
             ));
         }
     }
-    if let Some(xi) = c.spread_factor {
-        if !(xi.is_finite() && xi >= 1.0) {
-            return Err(cx.err(
-                "check.spread_factor",
-                format!("a spread factor D/D0 is at least 1, got {xi}"),
-            ));
-        }
-    }
     let liquids = phases
         .iter()
         .filter(|p| p.kind == PhaseKind::Liquid)
         .count();
-    if c.phase.is_none() && liquids > 1 {
+    if phase.is_none() && liquids > 1 {
         return Err(cx.err(
             "check.phase",
             format!(
                 "missing: \"{}\" in a scene with several liquid phases needs the droplet's",
-                c.kind.name()
+                kind.name()
             ),
         ));
     }
@@ -246,7 +278,7 @@ fn droplet_needs(cx: &Ctx, c: &CheckDef, dim: u32, phases: &[PhaseInfo]) -> Resu
 
 /// `binder` (F22 §4.2) measures a liquid in a rigid powder bed and judges at
 /// least one thing; its lengths are positive.
-fn binder_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
+fn binder_needs(cx: &Ctx, scene: &SceneFile, c: &BinderCheck) -> Result<(), InputError> {
     if !scene.powder.as_ref().is_some_and(|p| p.rigid) {
         return Err(cx.err(
             "check.kind",
@@ -283,7 +315,7 @@ fn binder_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputEr
 /// `deposition` (F22 §4.4) follows the scene's shape bodies (the grains) into a
 /// laser's pool; its references are positive, a diameter comes with its time,
 /// and it judges at least one thing.
-fn deposition_needs(cx: &Ctx, scene: &SceneFile, c: &CheckDef) -> Result<(), InputError> {
+fn deposition_needs(cx: &Ctx, scene: &SceneFile, c: &DepositionCheck) -> Result<(), InputError> {
     if scene.laser.is_none() || !scene.shapes.iter().any(|s| s.body) {
         return Err(cx.err(
             "check.kind",
@@ -351,7 +383,7 @@ fn thermocapillary_layout(
     dim: u32,
     phases: &[PhaseInfo],
     tension: Option<&SurfaceTension>,
-    c: &CheckDef,
+    y: f64,
 ) -> Result<(), InputError> {
     let bad = |msg: &str| Err(cx.err("check.kind", format!("\"thermocapillary\" needs {msg}")));
     let d = &scene.domain;
@@ -378,7 +410,6 @@ fn thermocapillary_layout(
             "two Dirichlet wall phases, one with a temperature_wave along x (the y_min wall)",
         );
     }
-    let y = c.surface.unwrap_or(f64::NAN);
     if !(y > d.min[1] && y < d.max[1]) {
         return Err(cx.err(
             "check.surface",

@@ -1,4 +1,5 @@
-//! Scenario files: the TOML format, `--set` overrides and validation.
+//! Scenario files: the TOML format (each section's types here, `[check]`'s in
+//! check.rs), `--set` overrides (overrides.rs) and the parse.
 //!
 //! Parsing is strict: unknown keys are errors, every physical value is checked for
 //! sign and range, and each message names the file and the dotted key.
@@ -6,6 +7,12 @@
 use crate::error::InputError;
 use serde::Deserialize;
 use std::collections::BTreeMap;
+
+mod check;
+mod overrides;
+
+pub use check::*;
+use overrides::apply_override;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -953,303 +960,6 @@ impl Default for WatchdogDef {
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CheckDef {
-    pub kind: CheckKind,
-    pub tolerance: f64,
-    /// Hydrostatic: initial free-surface height. Two-layer: interface height.
-    pub surface: Option<f64>,
-    /// Dam break: initial column width L.
-    pub column_width: Option<f64>,
-    /// Dam break: the experiment the metric compares with (default Koshizuka & Oka).
-    #[serde(default)]
-    pub experiment: DamBreakExperiment,
-    /// Hydrostatic: particles closer than this to the free surface are excluded (m).
-    pub exclude_depth: Option<f64>,
-    /// Laplace: centre and radius of the drop (m).
-    pub center: Option<Vec<f64>>,
-    pub radius: Option<f64>,
-    /// Recoil impulse: area of the hot surface (m², m per metre of depth in 2D).
-    /// Column expansion: the tank's cross-section (its width in 2D).
-    pub area: Option<f64>,
-    /// Thermal expansion: the mean volume error allowed in the band
-    /// 0.8 R < r < 0.9 R (default twice `tolerance`, R18's 0.8% against 0.4%).
-    pub band_tolerance: Option<f64>,
-    /// Free rotation: the largest relative change of the rotational energy.
-    pub energy_tolerance: Option<f64>,
-    /// Bed at rest: the time (s) after which no body may move (default: half
-    /// the run). Settling: the time after which the fall speed is averaged.
-    /// Thermal expansion, pressure noise: the time after which samples count.
-    pub settle_time: Option<f64>,
-    /// Rising amplitude: R18's swing of the drop's true density |ρ̄0/ρ̄0(0) − 1|
-    /// at failure (default 0.41: R18 Test 2 split at a 140% density increase,
-    /// 1.41 / 0.59 = 2.4).
-    pub swing: Option<f64>,
-    /// R18 track: the depth (m) a 2D slice stands for, so that R18's watts are
-    /// the power per metre times it. Its `surface` is the plate's initial top.
-    pub r18_slice_depth: Option<f64>,
-    /// remelt: the reference remelt depth (m; F22 §4.3).
-    pub depth: Option<f64>,
-    /// drop_contact: the first drop's share measured when the second touches
-    /// it, "solid" (default) or "liquid"; the tolerance bounds it from above.
-    #[serde(default)]
-    pub fraction: DropFraction,
-    /// splat: the droplet's phase (default: every liquid phase), for scenes
-    /// whose substrate is a liquid phase too (J22 §4.2).
-    pub phase: Option<String>,
-    /// splat: a reference spread factor D/D0 of the splat at the run's end
-    /// (J22 §4.2 measured its splats after 2 µs). With it the verdict is the
-    /// relative departure from it, not J22's Fluent-case timings.
-    pub spread_factor: Option<f64>,
-    /// deposition: the first grain's reference arrival at the substrate (s).
-    pub arrival: Option<f64>,
-    /// deposition: the reference pool diameter (m) at `diameter_time` (s),
-    /// within `diameter_tolerance` (relative, default 0.1).
-    pub diameter: Option<f64>,
-    pub diameter_time: Option<f64>,
-    pub diameter_tolerance: Option<f64>,
-    /// deposition: at least one grain must be left not fully molten.
-    pub unmolten: Option<bool>,
-    /// binder: the penetration (m) must end below this and the spread width
-    /// above that (a slower drop's figures: F22's order).
-    pub penetration_below: Option<f64>,
-    pub spread_above: Option<f64>,
-    /// binder: the binder must reach a side wall.
-    pub reaches_walls: Option<bool>,
-    /// binder: at least this many grains must be ejected.
-    pub ejected: Option<usize>,
-    /// binder: the binder must still move down at the end.
-    pub sinking: Option<bool>,
-    /// measured_track: the measured melt-pool figures and where the track is
-    /// steady.
-    pub measured: Option<MeasuredTrackDef>,
-}
-
-/// `[check.measured]` of `measured_track`: a laser track's melt pool as
-/// measured (width and depth from cross-sections of the solidified track,
-/// length from thermography of the moving pool), each with its tolerance.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MeasuredTrackDef {
-    /// m.
-    pub width: f64,
-    pub depth: f64,
-    pub length: f64,
-    /// [x0, x1] (m): the track's steady part, where width and depth are
-    /// averaged over the slices and the pool's length over the samples with the
-    /// beam centre inside it.
-    pub steady: Vec<f64>,
-    /// Relative tolerance of width and depth (default 0.10).
-    pub width_depth_tolerance: Option<f64>,
-    /// Relative tolerance of the length (default 0.20: thermography's
-    /// emissivity makes it the least certain).
-    pub length_tolerance: Option<f64>,
-}
-
-impl MeasuredTrackDef {
-    pub const WIDTH_DEPTH_TOLERANCE: f64 = 0.10;
-    pub const LENGTH_TOLERANCE: f64 = 0.20;
-    /// Its own keys' validation (exit 2 naming the key).
-    pub fn validate(&self, file: &str, dim: u32) -> Result<(), crate::error::InputError> {
-        let err = |k: &str, m: String| {
-            crate::error::InputError::new(file, &format!("check.measured.{k}"), m)
-        };
-        for (k, v) in [
-            ("width", self.width),
-            ("depth", self.depth),
-            ("length", self.length),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(err(k, format!("must be a positive length in m (got {v})")));
-            }
-        }
-        if dim != 3 {
-            return Err(err(
-                "width",
-                "a measured track's width needs a 3D scene".into(),
-            ));
-        }
-        if self.steady.len() != 2 || !(self.steady[0] < self.steady[1]) {
-            return Err(err("steady", "expected [x0, x1] with x0 < x1 (m)".into()));
-        }
-        for (k, v) in [
-            ("width_depth_tolerance", self.width_depth_tolerance),
-            ("length_tolerance", self.length_tolerance),
-        ] {
-            if let Some(t) = v {
-                if !(t.is_finite() && t > 0.0 && t < 1.0) {
-                    return Err(err(k, format!("a relative tolerance in (0, 1) (got {t})")));
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Surge-front data for a column of width L and height 2L (checks/dam_break.rs holds the tables).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum DamBreakExperiment {
-    /// Koshizuka & Oka (1996), L = 0.146 m.
-    #[default]
-    KoshizukaOka,
-    /// Martin & Moyce (1952), n² = 2, a = 2.25 in.
-    MartinMoyce,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CheckKind {
-    Hydrostatic,
-    Poiseuille,
-    Couette,
-    DamBreakFront,
-    TwoLayer,
-    /// Semi-infinite solid, surface held at a fixed temperature: erf solution.
-    #[serde(rename = "conduction_1d")]
-    Conduction1d,
-    /// Steady conduction through two layers between two Dirichlet walls.
-    ConductionTwoMaterials,
-    /// Closed adiabatic box: total enthalpy constant.
-    Adiabatic,
-    /// One-phase Stefan problem: melting front s(t) = 2λ√(α t).
-    #[serde(rename = "stefan_1d")]
-    Stefan1d,
-    /// Two-phase Stefan (Neumann) solidification from a cold wall: the
-    /// solidification record's G and R against the front's gradient and speed.
-    SolidificationFront,
-    /// Energy balance with a laser: enthalpy gained = ζ ∫P dt − energy lost
-    /// through Dirichlet walls (none in an insulated scene).
-    LaserEnergy,
-    /// Quasi-steady temperature around a moving source on a plate (Rosenthal).
-    Rosenthal,
-    /// Weak compressibility: the largest (ρ − ρ0)/ρ0 of any liquid particle at any
-    /// sample, the cost side of a WCSPH sound speed (c ≥ 10 u_max aims at about 1%).
-    Compression,
-    /// Pressure jump across a drop's surface against Laplace's σ/R (2D), 2σ/R (3D).
-    Laplace,
-    /// Momentum a free layer gains from the recoil pressure against −∫ p_v A dt.
-    RecoilImpulse,
-    /// A 2D drop (a square at the start) relaxed to a disc: the spread of its
-    /// outline's radius over 32 sectors, in Δx.
-    DropShape,
-    /// A 2D sessile drop on the y_min wall settles at its static contact angle.
-    ContactAngle,
-    /// Marangoni flow in a two-layer channel over a wall heated as a cosine
-    /// (Pendse & Esmaeeli 2010): the interface velocity against the Stokes solution.
-    Thermocapillary,
-    /// Two rigid bodies collide head-on: the coefficient of restitution against
-    /// the spring–dashpot's analytic value.
-    Restitution,
-    /// A free rigid body: angular momentum and energy conserved, the
-    /// intermediate-axis flip.
-    FreeRotation,
-    /// A body lighter than the liquid floats with the immersed depth Archimedes
-    /// gives.
-    Flotation,
-    /// Bodies at rest (a poured bed under gravity) stay at rest.
-    BedAtRest,
-    /// A grain dropped into a melt melts completely, conserving mass and momentum.
-    MeltingGrain,
-    /// A 2D disc settling midway between two walls reaches Faxén's terminal velocity.
-    Settling,
-    /// R18 Test 1: a load-free drop under a thermal cycle takes the volume its
-    /// density law asks for (each particle's m/ρ against m/ρ0(T)).
-    ThermalExpansion,
-    /// R18 Test 3: two fluids in an open tank, the lower one expanding: each
-    /// fluid's height against its true volume over the tank's width (`area`).
-    ColumnExpansion,
-    /// R18 Test 2: Test 1 with an amplitude that grows; the density increase
-    /// reached before the drop splits, against R18's.
-    RisingAmplitude,
-    /// R18 Test 4: the RMS departure of interior pressures from their local
-    /// smooth mean, relative to ρ_l g H (checks/noise.rs).
-    PressureNoise,
-    /// R18 §5.1.1: a 2D powder-bed track's substrate penetration, peak
-    /// temperature and speed beside R18's Table 5.3 at the run's power.
-    R18Track,
-    /// J22 §4.1: a droplet's impact, mean vertical velocity through zero and
-    /// stop against J22's Fluent comparison; splat diameter and height.
-    Splat,
-    /// A 3D droplet landing on a flat wall: the peak of the wall force (the
-    /// droplet's rate of change of momentum) against 0.8 ρV²D² (inertial regime).
-    ImpactForce,
-    /// F22 §4.3: the deepest substrate remelt under a molten drop against a
-    /// reference depth (`depth`).
-    Remelt,
-    /// F22 §4.3, two and three drops: the share of the first drop that is
-    /// solid (or liquid: `fraction`) when the second first touches it.
-    DropContact,
-    /// F22 §4.5, PBF point melting: peak temperature above T_v, a depression
-    /// deeper than a quarter of its width while the beam is on, an ejected
-    /// grain, an indentation below the plate's top after solidification.
-    PointMelt,
-    /// F22 §4.4, directed energy deposition: the first grain's arrival, the
-    /// pool's diameter at a time, grains left not fully molten.
-    Deposition,
-    /// F22 §4.2, binder jetting: the binder's penetration into the bed and
-    /// its spread against a slower drop's, binder at the walls, ejected grains.
-    Binder,
-    /// A laser track's melt pool (width, depth, length) against a measured one
-    /// (`[check.measured]`); counts the figures outside their tolerance.
-    MeasuredTrack,
-}
-
-/// `check.fraction` of `drop_contact`: which share of the first drop it measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DropFraction {
-    #[default]
-    Solid,
-    Liquid,
-}
-
-impl CheckKind {
-    /// The name as written in scenario files.
-    pub fn name(self) -> &'static str {
-        match self {
-            CheckKind::Hydrostatic => "hydrostatic",
-            CheckKind::Poiseuille => "poiseuille",
-            CheckKind::Couette => "couette",
-            CheckKind::DamBreakFront => "dam_break_front",
-            CheckKind::TwoLayer => "two_layer",
-            CheckKind::Conduction1d => "conduction_1d",
-            CheckKind::ConductionTwoMaterials => "conduction_two_materials",
-            CheckKind::Adiabatic => "adiabatic",
-            CheckKind::Stefan1d => "stefan_1d",
-            CheckKind::SolidificationFront => "solidification_front",
-            CheckKind::LaserEnergy => "laser_energy",
-            CheckKind::Rosenthal => "rosenthal",
-            CheckKind::Compression => "compression",
-            CheckKind::Laplace => "laplace",
-            CheckKind::RecoilImpulse => "recoil_impulse",
-            CheckKind::DropShape => "drop_shape",
-            CheckKind::ContactAngle => "contact_angle",
-            CheckKind::Thermocapillary => "thermocapillary",
-            CheckKind::Restitution => "restitution",
-            CheckKind::FreeRotation => "free_rotation",
-            CheckKind::Flotation => "flotation",
-            CheckKind::BedAtRest => "bed_at_rest",
-            CheckKind::MeltingGrain => "melting_grain",
-            CheckKind::Settling => "settling",
-            CheckKind::ThermalExpansion => "thermal_expansion",
-            CheckKind::RisingAmplitude => "rising_amplitude",
-            CheckKind::ColumnExpansion => "column_expansion",
-            CheckKind::PressureNoise => "pressure_noise",
-            CheckKind::R18Track => "r18_track",
-            CheckKind::Splat => "splat",
-            CheckKind::ImpactForce => "impact_force",
-            CheckKind::Remelt => "remelt",
-            CheckKind::DropContact => "drop_contact",
-            CheckKind::PointMelt => "point_melt",
-            CheckKind::Deposition => "deposition",
-            CheckKind::Binder => "binder",
-            CheckKind::MeasuredTrack => "measured_track",
-        }
-    }
-}
-
 /// Parse scenario text (named `file` in messages). Returns the scene and the resolved
 /// TOML text after overrides, which is what a run records for reproduction.
 pub fn parse_str(
@@ -1270,18 +980,33 @@ pub fn parse_str(
     } else {
         resolved.as_str()
     };
-    let scene: SceneFile = toml::from_str(src)
-        .map_err(|e| InputError::new(file, &error_key_from_text(&e, src), describe(&e, src)))?;
+    let scene: SceneFile = toml::from_str(src).map_err(|e| {
+        let mut key = error_key_from_text(&e, src);
+        let mut msg = describe(&e, src);
+        // `[check]` is a tagged enum, read through serde's buffer: its errors
+        // point at the section. Re-read it as its kind's own struct for the key.
+        if key == "check" {
+            if let Some((k, m)) = table.get("check").and_then(CheckDef::key_error) {
+                key = format!("check.{k}");
+                msg = match e.span() {
+                    Some(s) => format!("{m} (line {})", line_of(src, s.start)),
+                    None => m,
+                };
+            }
+        }
+        InputError::new(file, &key, msg)
+    })?;
     Ok((scene, resolved))
+}
+
+fn line_of(text: &str, at: usize) -> usize {
+    text[..at.min(text.len())].matches('\n').count() + 1
 }
 
 fn describe(e: &toml::de::Error, text: &str) -> String {
     let msg = e.message().trim().to_string();
     match e.span() {
-        Some(span) => {
-            let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
-            format!("{msg} (line {line})")
-        }
+        Some(span) => format!("{msg} (line {})", line_of(text, span.start)),
         None => msg,
     }
 }
@@ -1291,6 +1016,18 @@ fn error_key_from_text(e: &toml::de::Error, text: &str) -> String {
         return String::new();
     };
     let upto = &text[..span.start.min(text.len())];
+    let rest = &text[span.start.min(text.len())..];
+    if let Some(header) = rest
+        .lines()
+        .next()
+        .map(str::trim)
+        .filter(|l| l.starts_with('['))
+    {
+        return header
+            .trim_matches(|c| c == '[' || c == ']')
+            .trim()
+            .to_string();
+    }
     let mut section = String::new();
     for line in upto.lines() {
         let t = line.trim();
@@ -1299,7 +1036,6 @@ fn error_key_from_text(e: &toml::de::Error, text: &str) -> String {
         }
     }
     let line = upto.rsplit('\n').next().unwrap_or("");
-    let rest = &text[span.start.min(text.len())..];
     let full_line = format!("{line}{}", rest.lines().next().unwrap_or(""));
     let key = full_line
         .split('=')
@@ -1313,162 +1049,5 @@ fn error_key_from_text(e: &toml::de::Error, text: &str) -> String {
         (false, true) => format!("{section}.{key}"),
         (false, false) => section,
         (true, false) => String::new(),
-    }
-}
-
-/// Sections searched, in order, for a bare `--set name=value`.
-const ALIAS_SECTIONS: [&str; 4] = ["simulation", "run", "domain", "check"];
-
-fn apply_override(file: &str, table: &mut toml::Table, ov: &str) -> Result<(), InputError> {
-    let Some((key, raw)) = ov.split_once('=') else {
-        return Err(InputError::new(file, ov, "--set expects key=value"));
-    };
-    let key = key.trim();
-    let value = parse_value(raw.trim());
-    let path: Vec<String> = if key.contains('.') {
-        key.split('.').map(str::to_string).collect()
-    } else {
-        let hits: Vec<&str> = ALIAS_SECTIONS
-            .iter()
-            .copied()
-            .filter(|s| {
-                table
-                    .get(*s)
-                    .and_then(|t| t.as_table())
-                    .is_some_and(|t| t.contains_key(key))
-            })
-            .collect();
-        match hits.as_slice() {
-            [one] => vec![one.to_string(), key.to_string()],
-            [] => {
-                // Not present yet: an optional key of [run] or [simulation].
-                let section = if RUN_KEYS.contains(&key) {
-                    "run"
-                } else {
-                    "simulation"
-                };
-                vec![section.to_string(), key.to_string()]
-            }
-            _ => {
-                return Err(InputError::new(
-                    file,
-                    key,
-                    format!(
-                        "--set: ambiguous key, found in sections {}; write section.key",
-                        hits.join(", ")
-                    ),
-                ))
-            }
-        }
-    };
-    for (k, seg) in path.iter().enumerate() {
-        let bracket = seg.contains(['[', ']']);
-        if bracket && (indexed(seg).is_none() || k + 1 == path.len()) {
-            return Err(InputError::new(
-                file,
-                key,
-                format!(
-                    "--set: `{seg}`: an array-of-tables entry is written name[k] with k a whole \
-                     number from 0, followed by a key (shapes[0].velocity=[0.0, 0.0, -1.0])"
-                ),
-            ));
-        }
-    }
-    let mut node = table;
-    for seg in &path[..path.len() - 1] {
-        node = match indexed(seg) {
-            Some((name, k)) => array_entry(file, key, node, name, k)?,
-            None => node
-                .entry(seg.clone())
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()))
-                .as_table_mut()
-                .ok_or_else(|| {
-                    InputError::new(file, key, format!("--set: `{seg}` is not a table"))
-                })?,
-        };
-    }
-    node.insert(path[path.len() - 1].clone(), value);
-    Ok(())
-}
-
-/// `name[k]` in a `--set` path: an entry of an array of tables
-/// (`shapes[0].velocity=[0, 0, -10]`).
-fn indexed(seg: &str) -> Option<(&str, usize)> {
-    let (name, rest) = seg.split_once('[')?;
-    let k = rest.strip_suffix(']')?.trim();
-    // Digits only: usize's parser would take "+1".
-    if name.is_empty() || !k.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    Some((name, k.parse().ok()?))
-}
-
-/// Table `k` of the array of tables `name` in `node`; a missing array or an
-/// index past its end is an error naming the key.
-fn array_entry<'a>(
-    file: &str,
-    key: &str,
-    node: &'a mut toml::Table,
-    name: &str,
-    k: usize,
-) -> Result<&'a mut toml::Table, InputError> {
-    let err = |why: String| InputError::new(file, key, format!("--set: {why}"));
-    let array = node
-        .get_mut(name)
-        .and_then(|v| v.as_array_mut())
-        .ok_or_else(|| err(format!("the scene has no [[{name}]] entries")))?;
-    let n = array.len();
-    array
-        .get_mut(k)
-        .ok_or_else(|| {
-            let entries = if n == 1 { "entry" } else { "entries" };
-            err(format!(
-                "index {k} is past the {n} [[{name}]] {entries} (indices from 0)"
-            ))
-        })?
-        .as_table_mut()
-        .ok_or_else(|| err(format!("`{name}[{k}]` is not a table")))
-}
-
-/// Every key of `[run]` (RunDef's fields): a bare `--set` name not yet in the
-/// file goes to `[run]` when it is one of these, else to `[simulation]`.
-const RUN_KEYS: [&str; 9] = [
-    "end_time",
-    "steps",
-    "dt",
-    "max_dt",
-    "output_interval",
-    "diagnostics_interval",
-    "dt_check",
-    "stop_when",
-    "stop_grace",
-];
-
-fn parse_value(raw: &str) -> toml::Value {
-    let doc = format!("v = {raw}");
-    match doc.parse::<toml::Table>() {
-        Ok(mut t) => t
-            .remove("v")
-            .unwrap_or(toml::Value::String(raw.to_string())),
-        Err(_) => toml::Value::String(raw.to_string()),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    /// RUN_KEYS names every field of RunDef (serde's refusal of an unknown key
-    /// lists them): a bare `--set max_dt=…` once went to `[simulation]` and
-    /// exited 2.
-    #[test]
-    fn run_keys_are_every_field_of_run() {
-        let err = toml::from_str::<super::RunDef>("not_a_key = 1")
-            .unwrap_err()
-            .to_string();
-        let listed = err.split("expected one of").nth(1).expect(&err);
-        let mut fields: Vec<&str> = listed.split('`').skip(1).step_by(2).collect();
-        let mut keys = super::RUN_KEYS.to_vec();
-        fields.sort_unstable();
-        keys.sort_unstable();
-        assert_eq!(fields, keys);
     }
 }

@@ -98,21 +98,35 @@ pub(crate) fn cmd_validate(path: &str, sets: &[String]) -> Result<ExitCode, Spat
     Ok(ExitCode::SUCCESS)
 }
 
-/// Measured throughputs (particle-steps/s) a scene's cost is projected from,
-/// docs/benchmarks.md: (one H100, 2 CPU cores of the CI machine kind). Plain
-/// WCSPH: the H100 at 1.6e7 particles (2026-11-23), this 2-core machine's CPU
-/// at 1e6 (dam_break_3d). Heat and laser scenes: the H100 on
-/// line_melt_bare_plate (2.8e5 particles, 2026-11-23), the CPU on melt_block_3d.
-const PLAIN_RATES: (f64, f64) = (1.34e8, 1.7e6);
+/// One class of scene's measured throughput (particle-steps/s), a table of
+/// docs/benchmarks/cost_rates.toml.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Rate {
+    /// How the cost line names the class.
+    what: String,
+    /// One H100; none where no device has measured the class.
+    gpu: Option<f64>,
+    /// 2 CPU cores of the CI machine kind.
+    cpu: f64,
+    /// Said after the step count (how far the projection can be off).
+    note: Option<String>,
+}
 
-const HEAT_RATES: (f64, f64) = (3.65e7, 4.3e5);
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Rates {
+    plain: Rate,
+    heat: Rate,
+    ray_traced: Rate,
+    dfsph: Rate,
+}
 
-/// DFSPH (its solves are several neighbour sweeps a step): the CPU on the
-/// 62 um spray spread at 27 048 particles (2026-12-05, after the CPU's pair
-/// table; the slowest per particle of the spray scenes: the 30 um spread ran
-/// at 2.0e5, the 3D Fluent case at 11 364 particles at 5.9e5). No GPU figure:
-/// no device has been lent since DFSPH landed.
-const DFSPH_CPU_RATE: f64 = 1.3e5;
+/// The measured throughputs, read from the benchmarks' record at build time.
+fn rates() -> Rates {
+    toml::from_str(include_str!("../../docs/benchmarks/cost_rates.toml"))
+        .expect("docs/benchmarks/cost_rates.toml: the cost rates (checked by a unit test)")
+}
 
 /// `validate`'s cost line: steps at the initial time step (the smallest of the
 /// scene's limits and of the flow's own CFL at its initial speeds, which binds
@@ -135,13 +149,19 @@ fn print_cost(m: &spatter::model::Model, params: &Params, st: &spatter::state::S
     };
     let work = steps * st.len() as f64;
     let heat = m.phases.iter().any(|p| p.conducts());
-    let dfsph = m.formulation == spatter::scene::Formulation::Dfsph;
-    let ((gpu, cpu), which) = if dfsph {
-        ((f64::NAN, DFSPH_CPU_RATE), "a DFSPH spray scene's")
+    let traced = m
+        .laser
+        .as_ref()
+        .is_some_and(|l| l.model == spatter::scene::LaserModel::RayTraced);
+    let all = rates();
+    let rate = if m.formulation == spatter::scene::Formulation::Dfsph {
+        &all.dfsph
+    } else if traced {
+        &all.ray_traced
     } else if heat {
-        (HEAT_RATES, "a laser heat scene's")
+        &all.heat
     } else {
-        (PLAIN_RATES, "plain WCSPH's")
+        &all.plain
     };
     let hours = |rate: f64| {
         let s = work / rate;
@@ -153,22 +173,35 @@ fn print_cost(m: &spatter::model::Model, params: &Params, st: &spatter::state::S
             format!("{:.1} h", s / 3600.0)
         }
     };
-    let adaptive = if m.fixed_dt.is_some() {
-        ""
-    } else if dfsph {
-        " (at the initial speeds; DFSPH's step follows the flow: the spray scenes took \
-         0.37-1.23 times this)"
-    } else {
-        " (the step adapts: more steps where the flow speeds up)"
+    let adaptive = match (&rate.note, m.fixed_dt) {
+        (_, Some(_)) => String::new(),
+        (Some(note), None) => format!(" ({note})"),
+        (None, None) => " (the step adapts: more steps where the flow speeds up)".to_string(),
     };
-    let on_gpu = if gpu.is_finite() {
-        format!("{} on one H100 ({gpu:.2e}/s)", hours(gpu))
-    } else {
-        "on one H100 not measured yet (no device lent since DFSPH landed)".to_string()
+    let on_gpu = match rate.gpu {
+        Some(gpu) => format!("{} on one H100 ({gpu:.2e}/s)", hours(gpu)),
+        None => "on one H100 not measured yet".to_string(),
     };
+    let (which, cpu) = (&rate.what, rate.cpu);
     println!(
         "cost: about {steps:.3e} steps{adaptive}, {work:.3e} particle-steps; at {which} measured \
-         rates (docs/benchmarks.md) {on_gpu}, {} on 2 CPU cores ({cpu:.2e}/s)",
+         rates (docs/benchmarks/cost_rates.toml) {on_gpu}, {} on 2 CPU cores ({cpu:.2e}/s)",
         hours(cpu)
     );
+}
+
+#[cfg(test)]
+mod tests {
+    /// The build's cost rates parse, and every figure is a positive rate.
+    #[test]
+    fn cost_rates_parse() {
+        let r = super::rates();
+        for rate in [&r.plain, &r.heat, &r.ray_traced, &r.dfsph] {
+            assert!(
+                rate.cpu > 0.0 && rate.gpu.is_none_or(|g| g > 0.0),
+                "{}",
+                rate.what
+            );
+        }
+    }
 }

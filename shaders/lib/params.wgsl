@@ -108,8 +108,8 @@ struct Laser {
     march_steps: u32,        // steps a ray may march between two hits
     // @align(16): naga takes a struct's alignment from its members' types, not
     // their @align, so PathPoint's own would not place the array (params.rs).
-    @align(16) path: array<PathPoint, 8>,
-    @align(16) power: array<PowerStep, 8>,
+    @align(16) path: array<PathPoint, 32>,
+    @align(16) power: array<PowerStep, 32>,
 }
 
 struct Bodies {              // rigid bodies, F22 (39)-(40) contact (FLAG_BODIES)

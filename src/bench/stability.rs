@@ -118,6 +118,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
     (scene_file!("pbf/amb2018_02_b"), &["dx=2e-5"]),
     (scene_file!("pbf/amb2018_02_c"), &["dx=2e-5"]),
     (scene_file!("pbf/line_melt_coarse_2d"), &[]),
+    (scene_file!("pbf/line_melt_scan_2d"), &[]),
     (scene_file!("pbf/r18_track_2d"), &[]),
     (
         scene_file!("pbf/powder_bed_line_melt_coarse_2d"),

@@ -3,7 +3,7 @@
 use super::*;
 
 /// Most path points and power steps the parameter block holds.
-pub const MAX_LASER_POINTS: usize = 8;
+pub const MAX_LASER_POINTS: usize = 32;
 
 /// Default rays per Δx across the beam (ray-traced model).
 pub const DEFAULT_RAYS_PER_DX: u32 = 2;
@@ -130,6 +130,9 @@ pub(super) fn laser_source(
     phases: &[PhaseInfo],
 ) -> Result<Option<Laser>, InputError> {
     let Some(l) = &scene.laser else {
+        if scene.scan.is_some() {
+            return Err(cx.err("scan", "a [scan] moves a beam: it needs a [laser]"));
+        }
         return Ok(None);
     };
     if !phases.iter().any(|p| p.conducts()) {
@@ -241,10 +244,17 @@ pub(super) fn laser_source(
     if let Some(t_off) = l.power_until {
         power = switch_off(power, t_off).map_err(|why| cx.err("laser.power_until", why))?;
     }
-    let path = points("laser.path", &l.path, dim as usize)?
-        .iter()
-        .map(|e| (e[0], [e[1], if dim == 3 { e[2] } else { 0.0 }]))
-        .collect();
+    let path = match &scene.scan {
+        Some(scan) => {
+            let (path, steps) = scan_tables(cx, scan, l, dim)?;
+            power = steps;
+            path
+        }
+        None => points("laser.path", &l.path, dim as usize)?
+            .iter()
+            .map(|e| (e[0], [e[1], if dim == 3 { e[2] } else { 0.0 }]))
+            .collect(),
+    };
     Ok(Some(Laser {
         model: l.model,
         absorptivity,
@@ -340,6 +350,128 @@ fn ray_tracing(
         max_bounces,
         optics,
     })
+}
+
+/// `[scan]` compiled to the laser's tables: per track k, the beam at its start
+/// from t_k (on, held for the dwell), then along the track at the scan speed
+/// to its end (off there); the turnaround moves it, off, to the next start.
+/// Tracks are `hatch_spacing` apart to the left of the first's direction;
+/// `alternating` reverses every other one. Returns (path, power steps).
+#[allow(clippy::type_complexity)]
+fn scan_tables(
+    cx: &Ctx,
+    scan: &crate::scene::ScanDef,
+    l: &crate::scene::LaserDef,
+    dim: u32,
+) -> Result<(Vec<(f64, [f64; 2])>, Vec<(f64, f64)>), InputError> {
+    let p = match l.power {
+        crate::scene::PowerDef::Constant(p) => p,
+        crate::scene::PowerDef::Schedule(_) => {
+            return Err(cx.err(
+                "laser.power",
+                "with a [scan] the power is one number: the scan switches it on and off",
+            ))
+        }
+    };
+    if !l.path.is_empty() {
+        return Err(cx.err("laser.path", "give the path or a [scan], not both"));
+    }
+    if l.power_until.is_some() {
+        return Err(cx.err(
+            "laser.power_until",
+            "with a [scan] the beam goes off at the end of the last track",
+        ));
+    }
+    let lateral = dim as usize - 1;
+    let in_plane = |key: &str, v: &[f64]| {
+        if v.len() != lateral || v.iter().any(|x| !x.is_finite()) {
+            return Err(cx.err(
+                key,
+                format!(
+                    "{lateral} finite number(s) in the plate's plane for a {dim}D scene, got {v:?}"
+                ),
+            ));
+        }
+        Ok(())
+    };
+    in_plane("scan.start", &scan.start)?;
+    let speed = cx.positive("scan.speed", scan.speed)?;
+    let length = cx.positive("scan.length", scan.length)?;
+    for (key, v) in [
+        ("scan.start_time", scan.start_time),
+        ("scan.dwell", scan.dwell),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(cx.err(key, format!("must be a time >= 0 (s), got {v}")));
+        }
+    }
+    let mut dir = [1.0, 0.0];
+    if let Some(d) = &scan.direction {
+        in_plane("scan.direction", d)?;
+        let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm > 0.0) {
+            return Err(cx.err("scan.direction", "must not be zero"));
+        }
+        for (a, v) in d.iter().enumerate() {
+            dir[a] = v / norm;
+        }
+    }
+    let n = scan.tracks as usize;
+    let per_track = if scan.dwell > 0.0 { 3 } else { 2 };
+    if n == 0 || n * per_track > MAX_LASER_POINTS {
+        return Err(cx.err(
+            "scan.tracks",
+            format!(
+                "1 to {} tracks ({MAX_LASER_POINTS} path points, {per_track} a track), got {n}",
+                MAX_LASER_POINTS / per_track
+            ),
+        ));
+    }
+    let (hatch, turn) = if n > 1 {
+        if dim != 3 {
+            return Err(cx.err("scan.tracks", "a 2D scene has one track"));
+        }
+        let h = scan.hatch_spacing.unwrap_or(f64::NAN);
+        let turn = scan.turnaround.unwrap_or(f64::NAN);
+        (
+            cx.positive("scan.hatch_spacing", h)?,
+            cx.positive("scan.turnaround", turn)?,
+        )
+    } else {
+        for (key, given) in [
+            ("scan.hatch_spacing", scan.hatch_spacing.is_some()),
+            ("scan.turnaround", scan.turnaround.is_some()),
+        ] {
+            if given {
+                return Err(cx.err(key, "only a scan of several tracks uses it"));
+            }
+        }
+        (0.0, 0.0)
+    };
+    let left = [-dir[1], dir[0]];
+    let pass = length / speed;
+    let (mut path, mut power) = (Vec::new(), Vec::new());
+    for k in 0..n {
+        let back = scan.pattern == crate::scene::HatchPattern::Alternating && k % 2 == 1;
+        let s = if back { length } else { 0.0 };
+        let e = length - s;
+        let at = |along: f64| {
+            let mut x = [0.0; 2];
+            for (a, xa) in x.iter_mut().enumerate().take(lateral) {
+                *xa = scan.start[a] + along * dir[a] + k as f64 * hatch * left[a];
+            }
+            x
+        };
+        let t = scan.start_time + k as f64 * (scan.dwell + pass + turn);
+        path.push((t, at(s)));
+        if scan.dwell > 0.0 {
+            path.push((t + scan.dwell, at(s)));
+        }
+        path.push((t + scan.dwell + pass, at(e)));
+        power.push((t, p));
+        power.push((t + scan.dwell + pass, 0.0));
+    }
+    Ok((path, power))
 }
 
 /// The schedule with the beam off from t_off on: steps at or after t_off are

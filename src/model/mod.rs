@@ -499,6 +499,15 @@ pub fn build(file: &str, scene: &SceneFile, resolved_toml: &str) -> Result<Model
         (dim, dx, h),
     ));
     watchdog_inputs(&cx, &scene.watchdog)?;
+    if let (Some(l), Some(t_end), Some(_)) = (&laser, run.end_time, &scene.scan) {
+        let last = l.power.last().map_or(0.0, |p| p.0);
+        if last > t_end {
+            warnings.push(format!(
+                "{file}: key `run.end_time`: the run ends at {t_end:.4e} s, before the scan's \
+                 last track ends at {last:.4e} s"
+            ));
+        }
+    }
 
     Ok(Model {
         file: file.to_string(),

@@ -203,6 +203,8 @@ pub struct SceneFile {
     #[serde(default)]
     pub watchdog: WatchdogDef,
     pub laser: Option<LaserDef>,
+    /// The beam's path as tracks (instead of `laser.path`).
+    pub scan: Option<ScanDef>,
     pub surface_tension: Option<SurfaceTensionDef>,
     pub powder: Option<PowderDef>,
     pub contact: Option<ContactDef>,
@@ -422,8 +424,61 @@ pub struct LaserDef {
     /// line melt's end, kept apart from the power so a sweep can vary it).
     pub power_until: Option<f64>,
     /// Scan path: [time, x] (2D) or [time, x, y] (3D) beam centres, linear in
-    /// between and held before the first and after the last.
+    /// between and held before the first and after the last. Absent where a
+    /// `[scan]` gives the tracks.
+    #[serde(default)]
     pub path: Vec<Vec<f64>>,
+}
+
+/// `[scan]`: the beam's path as a process engineer gives it, one track or a
+/// hatch of parallel tracks, compiled to the laser's path and power tables
+/// (the beam at `laser.power` on each track, off in the turns). The
+/// alternative to `laser.path` and `laser.power_until`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScanDef {
+    /// Where the first track starts: [x] (2D) or [x, y] (3D), m.
+    pub start: Vec<f64>,
+    /// The first track's direction along the plate: [1] or [-1] (2D), a
+    /// vector [dx, dy] in the plate's plane (3D; normalised). Default +x.
+    pub direction: Option<Vec<f64>>,
+    /// Scan speed (m/s).
+    pub speed: f64,
+    /// Each track's length (m).
+    pub length: f64,
+    /// When the first track starts (s; default 0).
+    #[serde(default)]
+    pub start_time: f64,
+    /// The beam on and held still at each track's start before it moves (s;
+    /// default 0).
+    #[serde(default)]
+    pub dwell: f64,
+    /// Number of parallel tracks (default 1; 3D only above 1).
+    #[serde(default = "one_track")]
+    pub tracks: u32,
+    /// Distance between neighbouring tracks' centre lines (m), to the left of
+    /// the first track's direction (+y for a track along +x).
+    pub hatch_spacing: Option<f64>,
+    /// Every track the same way (`unidirectional`, default) or each the
+    /// other way from the last (`alternating`, a serpentine).
+    #[serde(default)]
+    pub pattern: HatchPattern,
+    /// Beam off between one track's end and the next one's start (s), while
+    /// the beam moves over.
+    pub turnaround: Option<f64>,
+}
+
+fn one_track() -> u32 {
+    1
+}
+
+/// `scan.pattern`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HatchPattern {
+    #[default]
+    Unidirectional,
+    Alternating,
 }
 
 /// `simulation.interface_viscosity`: α at this Δx, or α at a reference Δx.

@@ -1,0 +1,200 @@
+//! `[scan]`: tracks as a process engineer gives them (start, direction, speed,
+//! length, dwell; hatches of parallel tracks), compiled to the laser's path
+//! and power tables.
+
+mod common;
+use spatter::load;
+use spatter::params::Params;
+
+/// A scene's text with its explicit path and switch-off taken out, written
+/// where the test can name it: the scan supplies both.
+fn without_path(name: &str) -> (String, String) {
+    let path = common::scene_at(name);
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with("power_until") && !l.starts_with("path ="))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let out = format!(
+        "{}/scan_{}.toml",
+        env!("CARGO_TARGET_TMPDIR"),
+        name.replace('/', "_")
+    );
+    std::fs::write(&out, &text).unwrap();
+    (out, text)
+}
+
+/// The README's 2D line melt gives its beam as an explicit path (held at
+/// x = 160 µm for 50 µs, then to 800 µm at 2 m/s, off at 370 µs);
+/// line_melt_scan_2d.toml gives the same line as a [scan]: the two pack into
+/// the same parameter block, bit for bit.
+#[test]
+fn a_scan_packs_as_the_explicit_path_it_stands_for() {
+    let explicit = load::load(&common::scene_at("pbf/line_melt_coarse_2d"), &[]).unwrap();
+    let scanned = load::load(&common::scene_at("pbf/line_melt_scan_2d"), &[]).unwrap();
+    let (a, b) = (
+        explicit.model.laser.as_ref().unwrap(),
+        scanned.model.laser.as_ref().unwrap(),
+    );
+    assert_eq!((b.path.len(), b.power.len()), (3, 2), "{b:?}");
+    for (p, q) in a.path.iter().zip(&b.path) {
+        assert!(
+            (p.0 - q.0).abs() < 1e-15 && p.1 == q.1,
+            "{:?} {:?}",
+            a.path,
+            b.path
+        );
+    }
+    let pa = Params::new(&explicit.model, explicit.state.len() as u32);
+    let pb = Params::new(&scanned.model, scanned.state.len() as u32);
+    assert!(
+        pa.uniform_bytes() == pb.uniform_bytes(),
+        "the parameter blocks differ"
+    );
+}
+
+/// Three alternating tracks 100 µm apart along +x, 500 µm at 1 m/s with a
+/// 200 µs turnaround: each track starts where the serpentine says, the beam
+/// is on only along the tracks, and the energy is P times the time on them.
+#[test]
+fn a_hatch_of_alternating_tracks() {
+    let scene = without_path("pbf/amb2018_02_c").0;
+    let sets: Vec<String> = [
+        "dx=4e-5",
+        "scan.start=[2.0e-4, 1.0e-4]",
+        "scan.speed=1.0",
+        "scan.length=5.0e-4",
+        "scan.tracks=3",
+        "scan.hatch_spacing=1.0e-4",
+        "scan.pattern=\"alternating\"",
+        "scan.turnaround=2.0e-4",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let l = load::load(&scene, &sets).unwrap();
+    let laser = l.model.laser.unwrap();
+    let ends: Vec<(f64, [f64; 2])> = laser.path.clone();
+    let expect = [
+        (0.0, [2.0e-4, 1.0e-4]),
+        (5.0e-4, [7.0e-4, 1.0e-4]),
+        (7.0e-4, [7.0e-4, 2.0e-4]),
+        (1.2e-3, [2.0e-4, 2.0e-4]),
+        (1.4e-3, [2.0e-4, 3.0e-4]),
+        (1.9e-3, [7.0e-4, 3.0e-4]),
+    ];
+    assert_eq!(ends.len(), expect.len(), "{ends:?}");
+    for (got, want) in ends.iter().zip(&expect) {
+        assert!((got.0 - want.0).abs() < 1e-12, "{ends:?}");
+        for a in 0..2 {
+            assert!((got.1[a] - want.1[a]).abs() < 1e-12, "{ends:?}");
+        }
+    }
+    // on along the tracks, off in the turns and after the last
+    for (t, on) in [
+        (2.5e-4, true),
+        (6.0e-4, false),
+        (1.0e-3, true),
+        (1.3e-3, false),
+        (2.0e-3, false),
+    ] {
+        assert_eq!(laser.power_at(t) > 0.0, on, "t = {t}: {:?}", laser.power);
+    }
+    let e = laser.energy_until(1.0);
+    assert!((e - 195.0 * 1.5e-3).abs() < 1e-9, "energy {e}");
+}
+
+/// What a scan cannot be: each exits 2 naming its key.
+#[test]
+fn bad_scans_exit_2_naming_the_key() {
+    let melt_3d = without_path("pbf/amb2018_02_c").0;
+    let melt_2d = without_path("pbf/line_melt_coarse_2d").0;
+    let scan3 = [
+        "scan.start=[2e-4, 1e-4]",
+        "scan.speed=1.0",
+        "scan.length=5e-4",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        scan3.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    for (extra, key) in [
+        (
+            &[
+                "scan.tracks=40",
+                "scan.hatch_spacing=1e-4",
+                "scan.turnaround=1e-4",
+            ][..],
+            "scan.tracks",
+        ),
+        (
+            &["scan.tracks=2", "scan.turnaround=1e-4"][..],
+            "scan.hatch_spacing",
+        ),
+        (
+            &["scan.tracks=2", "scan.hatch_spacing=1e-4"][..],
+            "scan.turnaround",
+        ),
+        (&["scan.hatch_spacing=1e-4"][..], "scan.hatch_spacing"),
+        (&["scan.speed=0.0"][..], "scan.speed"),
+        (&["scan.direction=[0.0, 0.0]"][..], "scan.direction"),
+        (&["scan.start=[2e-4]"][..], "scan.start"),
+        (&["scan.pattern=\"zigzag\""][..], "scan.pattern"),
+    ] {
+        let mut args = vec!["validate".to_string(), melt_3d.clone()];
+        for s in with(extra) {
+            args.push("--set".into());
+            args.push(s);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::assert_input_error(&refs, key);
+    }
+    // the explicit path and a scan together; a 2D hatch
+    common::assert_input_error(
+        &[
+            "validate",
+            &melt_3d,
+            "--set",
+            "laser.path=[[0.0, 2.0e-4, 2.0e-4]]",
+            "--set",
+            "scan.start=[2e-4, 1e-4]",
+            "--set",
+            "scan.speed=1.0",
+            "--set",
+            "scan.length=5e-4",
+        ],
+        "laser.path",
+    );
+    common::assert_input_error(
+        &[
+            "validate",
+            &melt_2d,
+            "--set",
+            "laser.path=[]",
+            "--set",
+            "laser.power_until=1e-3",
+            "--set",
+            "scan.start=[1e-4]",
+            "--set",
+            "scan.speed=1.0",
+            "--set",
+            "scan.length=5e-4",
+        ],
+        "laser.power_until",
+    );
+    common::assert_input_error(
+        &[
+            "validate",
+            &melt_2d,
+            "--set",
+            "scan.start=[1e-4]",
+            "--set",
+            "scan.speed=1.0",
+            "--set",
+            "scan.length=5e-4",
+            "--set",
+            "scan.tracks=2",
+        ],
+        "scan.tracks",
+    );
+}

@@ -89,6 +89,10 @@ enum Command {
         /// Write the manifest and a Slurm job-array script instead of running.
         #[arg(long)]
         slurm: bool,
+        /// Layer thickness (m): a steady track shallower than this is lack of
+        /// fusion on the map (default: a powder scene's layer, else none).
+        #[arg(long, value_name = "M")]
+        layer: Option<f64>,
     },
     /// Benchmarks.
     Bench {
@@ -279,6 +283,16 @@ fn dispatch(cli: Cli) -> Result<ExitCode, SpatterError> {
             out,
             backend,
             slurm,
-        } => cmd_sweep(&args, &vary, &sets, jobs, &out, backend, slurm),
+            layer,
+        } => cmd_sweep(commands::sweep::SweepArgs {
+            args: &args,
+            vary: &vary,
+            sets: &sets,
+            jobs,
+            out: &out,
+            backend,
+            slurm,
+            layer,
+        }),
     }
 }

@@ -263,6 +263,7 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
             "mean_depth": t.mean(|s| s.depth),
             "mean_width": t.mean(|s| s.width),
             "mean_height": t.mean(|s| s.height),
+            "width_spread": t.width_spread(),
         })
     });
     serde_json::json!({
@@ -275,6 +276,7 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
         "dim": m.dim,
         "laser_radius": m.laser.as_ref().map(|l| l.radius),
         "laser_peak_power": m.laser.as_ref().map(|l| l.power.iter().map(|p| p.1).fold(0.0, f64::max)),
+        "layer_thickness": m.powder.as_ref().map(|b| b.thickness),
         "track": track,
         "laser": r.laser,
         "check": r.check.as_ref().map(|c| serde_json::json!({
@@ -285,20 +287,54 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
     })
 }
 
+/// Keyhole where the track's depth over its width exceeds this (3D): a pool
+/// deeper than half its width is no longer a conduction-mode half ellipse
+/// (the depth-to-width criterion of the keyhole literature, e.g. King et al.
+/// 2014's transition, where it reaches about 0.5).
+pub const KEYHOLE_DEPTH_OVER_WIDTH: f64 = 0.5;
+/// An unstable (balling) track where its width's coefficient of variation
+/// along the steady part exceeds this: a stable track's width varies by about
+/// a particle over its width at the resolutions swept (0.1–0.2 at 5–10
+/// particles across); a track breaking into beads varies by its whole width.
+pub const UNSTABLE_WIDTH_SPREAD: f64 = 0.3;
+
 /// One row of the collected CSV.
 struct Row {
     vary: Vec<(String, String)>,
     exit: Option<i32>,
+    dim: u32,
     depth: f64,
     width: f64,
     length: f64,
     mean_depth: f64,
+    mean_width: f64,
+    width_spread: f64,
     depression: f64,
     peak_t: f64,
+    layer: f64,
     regime: String,
 }
 
-fn row(s: &CellSummary) -> Row {
+/// The regime of a run that completed, by the criteria in order: lack of
+/// fusion (the steady track shallower than the layer), keyhole (3D: depth
+/// over width above KEYHOLE_DEPTH_OVER_WIDTH; 2D, where width is not defined:
+/// the surface under the beam sunk deeper than the beam radius), unstable
+/// (the width's spread above UNSTABLE_WIDTH_SPREAD), else conduction.
+fn regime(r: &Row, radius: f64) -> &'static str {
+    if r.layer > 0.0 && r.mean_depth < r.layer {
+        "lack_of_fusion"
+    } else if (r.dim == 3 && r.mean_depth / r.mean_width > KEYHOLE_DEPTH_OVER_WIDTH)
+        || (r.dim != 3 && radius > 0.0 && r.depression > radius)
+    {
+        "keyhole"
+    } else if r.width_spread > UNSTABLE_WIDTH_SPREAD {
+        "unstable"
+    } else {
+        "conduction"
+    }
+}
+
+fn row(s: &CellSummary, layer: Option<f64>) -> Row {
     let f = s.figures.as_ref();
     let num = |path: &[&str]| {
         let mut v = f;
@@ -307,37 +343,34 @@ fn row(s: &CellSummary) -> Row {
         }
         v.and_then(|x| x.as_f64()).unwrap_or(f64::NAN)
     };
-    let depression = num(&["track", "pool", "max_depression"]);
-    let radius = num(&["laser_radius"]);
-    let regime = match (
-        s.exit_code,
-        f.and_then(|x| x.get("end")).and_then(|e| e.as_str()),
-    ) {
-        (Some(0) | Some(1), Some("completed")) if depression.is_finite() && radius > 0.0 => {
-            if depression > radius {
-                "keyhole"
-            } else {
-                "conduction"
-            }
-            .to_string()
-        }
-        (code, _) => format!("exit {}", code.map_or("?".into(), |c| c.to_string())),
-    };
-    Row {
+    let mut r = Row {
         vary: s.vary.clone(),
         exit: s.exit_code,
+        dim: num(&["dim"]) as u32,
         depth: num(&["track", "pool", "max_depth"]),
         width: num(&["track", "pool", "max_width"]),
         length: num(&["track", "pool", "max_length"]),
         mean_depth: num(&["track", "mean_depth"]),
-        depression,
+        mean_width: num(&["track", "mean_width"]),
+        width_spread: num(&["track", "width_spread"]),
+        depression: num(&["track", "pool", "max_depression"]),
         peak_t: num(&["track", "pool", "max_temperature"]),
-        regime,
-    }
+        layer: layer.unwrap_or(num(&["layer_thickness"])),
+        regime: String::new(),
+    };
+    let completed = f.and_then(|x| x.get("end")).and_then(|e| e.as_str()) == Some("completed");
+    r.regime = match s.exit_code {
+        Some(0) | Some(1) if completed && r.mean_depth.is_finite() => {
+            regime(&r, num(&["laser_radius"])).to_string()
+        }
+        code => format!("exit {}", code.map_or("?".into(), |c| c.to_string())),
+    };
+    r
 }
 
-/// Gather the summaries of `dir` into sweep.csv and process_map.png.
-pub fn collect(dir: &Path) -> Result<(PathBuf, Option<PathBuf>), String> {
+/// Gather the summaries of `dir` into sweep.csv and process_map.png. `layer`
+/// (m) is the lack-of-fusion depth; without it a powder scene's layer.
+pub fn collect(dir: &Path, layer: Option<f64>) -> Result<(PathBuf, Option<PathBuf>), String> {
     let m = read_manifest(dir)?;
     let mut rows = Vec::new();
     for c in &m.cells {
@@ -346,25 +379,37 @@ pub fn collect(dir: &Path) -> Result<(PathBuf, Option<PathBuf>), String> {
             Ok(t) => {
                 let s: CellSummary =
                     serde_json::from_str(&t).map_err(|e| format!("{}: {e}", p.display()))?;
-                rows.push(row(&s));
+                rows.push(row(&s, layer));
             }
             Err(_) => println!("  cell {} {:?}: not run yet", c.index, c.vary),
         }
     }
     let mut csv = m.keys.join(",");
-    csv.push_str(",exit_code,max_depth_m,max_width_m,max_length_m,mean_remelt_depth_m,max_depression_m,peak_temperature_K,regime\n");
+    csv.push_str(
+        ",exit_code,max_depth_m,max_width_m,max_length_m,mean_remelt_depth_m,\
+         mean_width_m,depth_over_width,width_spread,max_depression_m,peak_temperature_K,\
+         layer_m,regime\n",
+    );
     for r in &rows {
         let vals: Vec<&str> = r.vary.iter().map(|(_, v)| v.as_str()).collect();
         csv.push_str(&format!(
-            "{},{},{:e},{:e},{:e},{:e},{:e},{:e},{}\n",
+            "{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{}\n",
             vals.join(","),
             r.exit.map_or(String::new(), |c| c.to_string()),
             r.depth,
             r.width,
             r.length,
             r.mean_depth,
+            r.mean_width,
+            if r.dim == 3 {
+                r.mean_depth / r.mean_width
+            } else {
+                f64::NAN
+            },
+            r.width_spread,
             r.depression,
             r.peak_t,
+            r.layer,
             r.regime
         ));
     }
@@ -375,78 +420,288 @@ pub fn collect(dir: &Path) -> Result<(PathBuf, Option<PathBuf>), String> {
     Ok((csv_path, drawn.then_some(png)))
 }
 
-/// Depth and width (µm, beside each point, with the regime) over the first
-/// two varied keys; false when a key's values are not numbers.
+/// A varied key's axis: the factor from SI to what is drawn, and the label.
+fn axis(key: &str, dim: u32) -> (f64, String) {
+    match key {
+        "laser.power" if dim == 2 => (1e-3, "laser power (kW per m of depth)".into()),
+        "laser.power" => (1.0, "laser power (W)".into()),
+        "scan.speed" => (1e3, "scan speed (mm/s)".into()),
+        "scan.hatch_spacing" => (1e6, "hatch spacing (µm)".into()),
+        "laser.radius" => (1e6, "beam radius (µm)".into()),
+        _ => (1.0, key.to_string()),
+    }
+}
+
+/// A tick label without an exponent: 1500, 2.5, 0.35.
+fn plain(v: f64) -> String {
+    let s = if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.3}")
+    };
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Colours of the filled contours, low to high (viridis at eight stops).
+const BANDS: [(u8, u8, u8); 8] = [
+    (68, 1, 84),
+    (70, 50, 127),
+    (54, 92, 141),
+    (39, 127, 142),
+    (31, 161, 135),
+    (74, 194, 109),
+    (159, 218, 58),
+    (253, 231, 37),
+];
+
+/// The process map: over the first two varied keys, filled contours (eight
+/// bands, bilinear between the runs) of the steady track's depth and of its
+/// width (2D: the pool's length, width being undefined in a slice), each
+/// run's point with its regime, and the boundaries between runs of different
+/// regimes drawn midway. False when a key's values are not numbers.
 fn process_map(path: &Path, keys: &[String], rows: &[Row]) -> Result<bool, String> {
     use plotters::prelude::*;
     let value = |r: &Row, k: usize| r.vary.get(k).and_then(|(_, v)| v.parse::<f64>().ok());
     let two = keys.len() >= 2;
+    let dim = rows.iter().map(|r| r.dim).max().unwrap_or(3);
+    let (sx, xlabel) = axis(&keys[0], dim);
+    let (sy, ylabel) = if two {
+        axis(&keys[1], dim)
+    } else {
+        (1.0, String::new())
+    };
     let pts: Vec<(f64, f64, &Row)> = rows
         .iter()
-        .filter_map(|r| Some((value(r, 0)?, if two { value(r, 1)? } else { 0.0 }, r)))
+        .filter_map(|r| {
+            Some((
+                value(r, 0)? * sx,
+                if two { value(r, 1)? * sy } else { 0.0 },
+                r,
+            ))
+        })
         .collect();
     if pts.is_empty() || pts.len() < rows.len() {
         return Ok(false);
     }
+    let distinct = |k: usize| {
+        let mut v: Vec<f64> = pts.iter().map(|p| if k == 0 { p.0 } else { p.1 }).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let (xs, ys) = (distinct(0), distinct(1));
+    // The runs on a full grid: value at (i, j), where the contours are drawn.
+    let at = |i: usize, j: usize| {
+        pts.iter()
+            .find(|p| p.0 == xs[i] && p.1 == ys[j])
+            .map(|p| p.2)
+    };
+    let full = xs.len() >= 2 && ys.len() >= 2 && pts.len() == xs.len() * ys.len();
     crate::bench::plot::register_fonts();
-    let range = |v: Vec<f64>| {
-        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
-            (a.0.min(x), a.1.max(x))
-        });
+    let range = |v: &[f64]| {
+        let (lo, hi) = (v[0], v[v.len() - 1]);
         let pad = if hi > lo {
-            0.15 * (hi - lo)
+            0.08 * (hi - lo)
         } else {
             0.5 * lo.abs().max(1.0)
         };
         (lo - pad)..(hi + pad)
     };
-    let (xr, yr) = (
-        range(pts.iter().map(|p| p.0).collect()),
-        range(pts.iter().map(|p| p.1).collect()),
-    );
-    let root = BitMapBackend::new(path, (1200, 520)).into_drawing_area();
+    let (xr, yr) = (range(&xs), range(&ys));
+    // room on the right for the legend (bands and regimes)
+    let xr = xr.start..xr.end + 0.45 * (xs[xs.len() - 1] - xs[0]).max(xr.end - xr.start);
+    let root = BitMapBackend::new(path, (1300, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let panels = root.split_evenly((1, 2));
+    let second: (&str, fn(&Row) -> f64) = if dim == 3 {
+        ("steady track width (µm)", |r| r.mean_width)
+    } else {
+        ("pool length (µm); width is not defined in 2D", |r| {
+            r.length
+        })
+    };
     for (panel, (name, pick)) in panels.iter().zip([
-        ("pool depth", (|r: &Row| r.depth) as fn(&Row) -> f64),
-        ("pool width", |r: &Row| r.width),
+        (
+            "steady track depth (µm)",
+            (|r: &Row| r.mean_depth) as fn(&Row) -> f64,
+        ),
+        second,
     ]) {
         let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{name} (µm) and regime"), ("sans-serif", 18))
+            .caption(name, ("sans-serif", 18))
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(80)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
             .build_cartesian_2d(xr.clone(), yr.clone())
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
-            .x_desc(keys[0].as_str())
-            .y_desc(if two { keys[1].as_str() } else { "" })
+            .disable_mesh()
+            .x_desc(xlabel.as_str())
+            .y_desc(ylabel.as_str())
             .label_style(("sans-serif", 13))
-            .x_label_formatter(&|v| format!("{v:.3e}"))
-            .y_label_formatter(&|v| format!("{v:.3e}"))
+            .x_label_formatter(&|v| plain(*v))
+            .y_label_formatter(&|v| plain(*v))
             .draw()
             .map_err(|e| e.to_string())?;
+        let vals: Vec<f64> = pts
+            .iter()
+            .map(|p| pick(p.2) * 1e6)
+            .filter(|v| v.is_finite())
+            .collect();
+        let (lo, hi) = vals
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+                (a.0.min(v), a.1.max(v))
+            });
+        if full && hi > lo {
+            let band = |v: f64| (((v - lo) / (hi - lo) * 8.0).floor() as usize).min(7);
+            let n = 48;
+            let mut cells = Vec::new();
+            for gi in 0..xs.len() - 1 {
+                for gj in 0..ys.len() - 1 {
+                    let corner =
+                        |a: usize, b: usize| at(gi + a, gj + b).map_or(f64::NAN, |r| pick(r) * 1e6);
+                    let (v00, v10, v01, v11) =
+                        (corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1));
+                    let (x0, x1, y0, y1) = (xs[gi], xs[gi + 1], ys[gj], ys[gj + 1]);
+                    for a in 0..n {
+                        for b in 0..n {
+                            let (u, w) = ((a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64);
+                            let v = v00 * (1.0 - u) * (1.0 - w)
+                                + v10 * u * (1.0 - w)
+                                + v01 * (1.0 - u) * w
+                                + v11 * u * w;
+                            if v.is_finite() {
+                                let (c0, c1) = (
+                                    x0 + (x1 - x0) * a as f64 / n as f64,
+                                    x0 + (x1 - x0) * (a + 1) as f64 / n as f64,
+                                );
+                                let (d0, d1) = (
+                                    y0 + (y1 - y0) * b as f64 / n as f64,
+                                    y0 + (y1 - y0) * (b + 1) as f64 / n as f64,
+                                );
+                                let (r, g, bl) = BANDS[band(v)];
+                                cells.push(Rectangle::new(
+                                    [(c0, d0), (c1, d1)],
+                                    RGBColor(r, g, bl).filled(),
+                                ));
+                            }
+                        }
+                    }
+                }
+            }
+            chart.draw_series(cells).map_err(|e| e.to_string())?;
+            for (k, &(r, g, bl)) in BANDS.iter().enumerate() {
+                let (a, b) = (
+                    lo + (hi - lo) * k as f64 / 8.0,
+                    lo + (hi - lo) * (k + 1) as f64 / 8.0,
+                );
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| e.to_string())?
+                    .label(format!("{a:.0}–{b:.0}"))
+                    .legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 5), (x + 12, y + 5)], RGBColor(r, g, bl).filled())
+                    });
+            }
+            // Regime boundaries: midway between neighbouring runs whose
+            // regimes differ.
+            let mut lines = Vec::new();
+            for i in 0..xs.len() {
+                for j in 0..ys.len() {
+                    let here = at(i, j).map(|r| r.regime.as_str());
+                    if i + 1 < xs.len() && here != at(i + 1, j).map(|r| r.regime.as_str()) {
+                        let xm = 0.5 * (xs[i] + xs[i + 1]);
+                        let y0 = if j == 0 {
+                            yr.start
+                        } else {
+                            0.5 * (ys[j - 1] + ys[j])
+                        };
+                        let y1 = if j + 1 == ys.len() {
+                            yr.end
+                        } else {
+                            0.5 * (ys[j] + ys[j + 1])
+                        };
+                        lines.push(PathElement::new(
+                            vec![(xm, y0), (xm, y1)],
+                            BLACK.stroke_width(3),
+                        ));
+                    }
+                    if j + 1 < ys.len() && here != at(i, j + 1).map(|r| r.regime.as_str()) {
+                        let ym = 0.5 * (ys[j] + ys[j + 1]);
+                        let x0 = if i == 0 {
+                            xr.start
+                        } else {
+                            0.5 * (xs[i - 1] + xs[i])
+                        };
+                        let x1 = if i + 1 == xs.len() {
+                            xr.end
+                        } else {
+                            0.5 * (xs[i] + xs[i + 1])
+                        };
+                        lines.push(PathElement::new(
+                            vec![(x0, ym), (x1, ym)],
+                            BLACK.stroke_width(3),
+                        ));
+                    }
+                }
+            }
+            chart.draw_series(lines).map_err(|e| e.to_string())?;
+        }
+        let marker = |regime: &str| match regime {
+            "conduction" => WHITE,
+            "keyhole" => RED,
+            "lack_of_fusion" => CYAN,
+            "unstable" => MAGENTA,
+            _ => BLACK,
+        };
+        let mut seen: Vec<&str> = Vec::new();
+        for &(_, _, r) in &pts {
+            if !seen.contains(&r.regime.as_str()) {
+                seen.push(r.regime.as_str());
+                let c = marker(&r.regime);
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| e.to_string())?
+                    .label(r.regime.replace('_', " "))
+                    .legend(move |(x, y)| {
+                        EmptyElement::at((x + 6, y))
+                            + Circle::new((0, 0), 5, c.filled())
+                            + Circle::new((0, 0), 5, BLACK.stroke_width(1))
+                    });
+            }
+        }
         for &(x, y, r) in &pts {
-            let colour = match r.regime.as_str() {
-                "keyhole" => RED,
-                "conduction" => BLUE,
-                _ => BLACK,
-            };
-            let v = pick(r);
-            // 2D runs have no width: the point carries its regime only.
-            let label = if v.is_finite() && v > 0.0 {
-                format!("{:.0} {}", v * 1e6, r.regime)
+            let v = pick(r) * 1e6;
+            let label = if v.is_finite() {
+                format!("{v:.0}")
             } else {
                 r.regime.clone()
             };
-            let font = ("sans-serif", 13).into_font().color(&colour);
+            let colour = marker(&r.regime);
+            let font = ("sans-serif", 13).into_font().color(&BLACK);
             chart
                 .draw_series(std::iter::once(
                     EmptyElement::at((x, y))
                         + Circle::new((0, 0), 6, colour.filled())
+                        + Circle::new((0, 0), 6, BLACK.stroke_width(1))
                         + Text::new(label, (9, -6), font),
                 ))
+                .map_err(|e| e.to_string())?;
+        }
+        {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 11))
+                .draw()
                 .map_err(|e| e.to_string())?;
         }
     }
@@ -476,5 +731,55 @@ mod tests {
         assert_eq!(g[5].folder, "cell_005");
         assert!(parse_vary("power").is_err());
         assert!(parse_vary("power=").is_err());
+    }
+
+    /// The regimes by their stated criteria, in order: lack of fusion below
+    /// the layer; keyhole at depth/width above 0.5 (3D) or a depression deeper
+    /// than the beam radius (2D); unstable at a width spread above 0.3.
+    #[test]
+    fn regimes_follow_their_criteria() {
+        let r = |dim: u32, depth: f64, width: f64, spread: f64, depression: f64, layer: f64| Row {
+            vary: Vec::new(),
+            exit: Some(0),
+            dim,
+            depth,
+            width,
+            length: f64::NAN,
+            mean_depth: depth,
+            mean_width: width,
+            width_spread: spread,
+            depression,
+            peak_t: f64::NAN,
+            layer,
+            regime: String::new(),
+        };
+        let radius = 50e-6;
+        assert_eq!(
+            regime(&r(3, 40e-6, 100e-6, 0.1, 0.0, f64::NAN), radius),
+            "conduction"
+        );
+        assert_eq!(
+            regime(&r(3, 60e-6, 100e-6, 0.1, 0.0, f64::NAN), radius),
+            "keyhole"
+        );
+        assert_eq!(
+            regime(&r(3, 40e-6, 100e-6, 0.4, 0.0, f64::NAN), radius),
+            "unstable"
+        );
+        assert_eq!(
+            regime(&r(3, 40e-6, 100e-6, 0.1, 0.0, 50e-6), radius),
+            "lack_of_fusion"
+        );
+        assert_eq!(
+            regime(&r(2, 40e-6, 0.0, f64::NAN, 60e-6, f64::NAN), radius),
+            "keyhole"
+        );
+        assert_eq!(
+            regime(&r(2, 40e-6, 0.0, f64::NAN, 10e-6, f64::NAN), radius),
+            "conduction"
+        );
+        assert_eq!(plain(1500.0), "1500");
+        assert_eq!(plain(2.5), "2.5");
+        assert_eq!(plain(0.35), "0.35");
     }
 }

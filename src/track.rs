@@ -355,6 +355,26 @@ impl TrackProfile {
     }
 
     /// The mean of a slice figure over the slices where it is finite.
+    /// How much the track's width varies along x in its steady part (the
+    /// slices between a tenth and nine tenths of the melted length): the
+    /// coefficient of variation std/mean of the widths; NaN in 2D (no width)
+    /// or with fewer than three slices there.
+    pub fn width_spread(&self) -> f64 {
+        let n = self.slices.len();
+        let steady = &self.slices[n / 10..n - n / 10];
+        let w: Vec<f64> = steady
+            .iter()
+            .map(|s| s.width)
+            .filter(|w| w.is_finite() && *w > 0.0)
+            .collect();
+        if w.len() < 3 {
+            return f64::NAN;
+        }
+        let mean = w.iter().sum::<f64>() / w.len() as f64;
+        let var = w.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / w.len() as f64;
+        var.sqrt() / mean
+    }
+
     pub fn mean(&self, f: impl Fn(&Slice) -> f64) -> f64 {
         let v: Vec<f64> = self
             .slices

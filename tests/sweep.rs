@@ -64,6 +64,19 @@ fn a_local_sweep_runs_each_cell_once_and_collects_a_map() {
     let (code, log) = sweep(&dir, &[]);
     assert_eq!(code, Some(0), "{log}");
     assert!(log.contains("2 done, 0 to run"), "{log}");
+    // With a layer thicker than any track, every run is lack of fusion; the
+    // CSV carries the figures the map's criteria use (2D: no depth/width).
+    let out = spatter(&["sweep", "collect", dir.to_str().unwrap(), "--layer", "1.0"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for column in ["depth_over_width", "width_spread", "layer_m", "regime"] {
+        assert!(header.contains(&column), "{csv}");
+    }
+    assert!(
+        csv.lines().skip(1).all(|r| r.ends_with(",lack_of_fusion")),
+        "{csv}"
+    );
 }
 
 /// The Slurm path writes a job array over the cells; where `sbatch` is not

@@ -6,22 +6,36 @@ use spatter::error::SpatterError;
 use spatter::run::{self, BackendChoice};
 use std::process::ExitCode;
 
-pub(crate) fn cmd_sweep(
-    args: &[String],
-    vary: &[String],
-    sets: &[String],
-    jobs: usize,
-    out: &str,
-    backend: BackendChoice,
-    slurm: bool,
-) -> Result<ExitCode, SpatterError> {
+/// `spatter sweep`'s command line.
+pub(crate) struct SweepArgs<'a> {
+    pub args: &'a [String],
+    pub vary: &'a [String],
+    pub sets: &'a [String],
+    pub jobs: usize,
+    pub out: &'a str,
+    pub backend: BackendChoice,
+    pub slurm: bool,
+    pub layer: Option<f64>,
+}
+
+pub(crate) fn cmd_sweep(a: SweepArgs) -> Result<ExitCode, SpatterError> {
+    let SweepArgs {
+        args,
+        vary,
+        sets,
+        jobs,
+        out,
+        backend,
+        slurm,
+        layer,
+    } = a;
     use spatter::sweep;
     use std::path::Path;
     let exe = std::env::current_exe().map_err(|e| SpatterError::Runtime(e.to_string()))?;
     let rt = SpatterError::Runtime;
     match args {
         [c, dir] if c == "collect" => {
-            let (csv, png) = sweep::collect(Path::new(dir)).map_err(rt)?;
+            let (csv, png) = sweep::collect(Path::new(dir), layer).map_err(rt)?;
             println!("sweep: {}", csv.display());
             match png {
                 Some(p) => println!("sweep: {}", p.display()),
@@ -110,7 +124,7 @@ pub(crate) fn cmd_sweep(
     }
     let done = sweep::run_local(dir, jobs, &exe).map_err(rt)?;
     let failed = done.iter().filter(|s| s.exit_code != Some(0)).count();
-    let (csv, png) = sweep::collect(dir).map_err(rt)?;
+    let (csv, png) = sweep::collect(dir, layer).map_err(rt)?;
     println!(
         "sweep: {} runs, {failed} not exit 0; {}",
         done.len(),

@@ -93,6 +93,9 @@ enum Command {
         /// fusion on the map (default: a powder scene's layer, else none).
         #[arg(long, value_name = "M")]
         layer: Option<f64>,
+        /// An #SBATCH option for the job array (repeat): `--slurm-arg=--partition=gpu`.
+        #[arg(long = "slurm-arg", value_name = "OPTION", allow_hyphen_values = true)]
+        slurm_args: Vec<String>,
     },
     /// Benchmarks.
     Bench {
@@ -284,6 +287,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode, SpatterError> {
             backend,
             slurm,
             layer,
+            slurm_args,
         } => cmd_sweep(commands::sweep::SweepArgs {
             args: &args,
             vary: &vary,
@@ -293,6 +297,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode, SpatterError> {
             backend,
             slurm,
             layer,
+            slurm_args: &slurm_args,
         }),
     }
 }

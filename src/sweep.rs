@@ -102,12 +102,22 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, String> {
 }
 
 /// The Slurm job-array script of a sweep: task i runs cell i.
-pub fn slurm_script(dir: &Path, exe: &Path, cells: usize, backend: &str) -> String {
-    let gpus = if backend == "cpu" {
-        ""
+/// `extra` are the site's own options (`--partition=gpu`), one #SBATCH line each.
+pub fn slurm_script(
+    dir: &Path,
+    exe: &Path,
+    cells: usize,
+    backend: &str,
+    extra: &[String],
+) -> String {
+    let mut gpus = if backend == "cpu" {
+        String::new()
     } else {
-        "#SBATCH --gpus=1\n"
+        "#SBATCH --gpus=1\n".to_string()
     };
+    for e in extra {
+        gpus.push_str(&format!("#SBATCH {e}\n"));
+    }
     format!(
         "#!/bin/bash\n\
          # spatter sweep: one array task per cell of {dir}/manifest.json.\n\

@@ -137,3 +137,40 @@ fn a_bad_value_in_the_grid_is_an_input_error_before_any_run() {
         "laser.power_until",
     );
 }
+
+/// A real Slurm: tools/slurm_cluster.sh starts a one-node cluster (munged,
+/// slurmctld, slurmd), submits a sweep's job array with `sbatch --wait` and
+/// checks that every cell's figures equal a local sweep's. It needs Slurm
+/// installed and root (the daemons run as root); elsewhere this test says so
+/// and passes, and the script is run by hand (it installs Slurm itself).
+#[test]
+fn a_real_slurm_runs_the_array_with_the_local_figures() {
+    let have = |cmd: &str| {
+        std::process::Command::new("sh")
+            .args(["-c", &format!("command -v {cmd}")])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    let root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    if !(have("slurmctld") && have("slurmd") && have("munged") && have("sbatch") && root) {
+        eprintln!("Slurm is not installed here, or not as root: tools/slurm_cluster.sh not run");
+        return;
+    }
+    let out = std::process::Command::new("bash")
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tools/slurm_cluster.sh"
+        ))
+        .arg(env!("CARGO_BIN_EXE_spatter"))
+        .output()
+        .unwrap();
+    let (o, e) = text(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(
+        o.contains("2 cells through sbatch, figures equal"),
+        "{o}{e}"
+    );
+}

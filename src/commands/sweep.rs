@@ -16,6 +16,7 @@ pub(crate) struct SweepArgs<'a> {
     pub backend: BackendChoice,
     pub slurm: bool,
     pub layer: Option<f64>,
+    pub slurm_args: &'a [String],
 }
 
 pub(crate) fn cmd_sweep(a: SweepArgs) -> Result<ExitCode, SpatterError> {
@@ -28,6 +29,7 @@ pub(crate) fn cmd_sweep(a: SweepArgs) -> Result<ExitCode, SpatterError> {
         backend,
         slurm,
         layer,
+        slurm_args,
     } = a;
     use spatter::sweep;
     use std::path::Path;
@@ -111,7 +113,8 @@ pub(crate) fn cmd_sweep(a: SweepArgs) -> Result<ExitCode, SpatterError> {
         let dir_abs = std::fs::canonicalize(dir).map_err(|e| rt(e.to_string()))?;
         spatter::output::write_atomic(
             &script,
-            sweep::slurm_script(&dir_abs, &exe, manifest.cells.len(), backend).as_bytes(),
+            sweep::slurm_script(&dir_abs, &exe, manifest.cells.len(), backend, slurm_args)
+                .as_bytes(),
         )
         .map_err(rt)?;
         println!(

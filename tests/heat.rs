@@ -370,6 +370,37 @@ fn coarse_line_melt_main_job() {
     let r = common::reader(&["track", mcap.to_str().unwrap(), png.to_str().unwrap()]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    // The reader as a package: the same run as DataFrames.
+    let py = "import sys, json; import spatter_read as s; p = sys.argv[1]; \
+              d = s.diagnostics(p); ps = s.pool_series(p); fr = s.frames(p); \
+              tr = s.track_slices(p); \
+              print(json.dumps([len(d), float(ps['pool_length'].max()), len(fr), \
+              fr[-1].attrs['time'], int(len(fr[-1])), 'temperature' in fr[-1], \
+              len(tr), float(tr['depth'].max())]))";
+    let o = std::process::Command::new(common::python())
+        .args(["-c", py, mcap.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let (so, se) = common::text(&o);
+    let v: serde_json::Value =
+        serde_json::from_str(so.trim()).unwrap_or_else(|_| panic!("{so}{se}"));
+    assert_eq!(v[0].as_u64(), sum["diagnostics"].as_u64(), "{v} {sum}");
+    let longest = sum["diagnostics_max"]["pool_length"].as_f64().unwrap();
+    assert!(
+        (v[1].as_f64().unwrap() - longest).abs() <= 1e-12 * longest,
+        "{v} {sum}"
+    );
+    assert_eq!(v[2].as_u64(), sum["frames"].as_u64(), "{v} {sum}");
+    assert!(
+        v[4].as_u64().unwrap() > 1000 && v[5].as_bool() == Some(true),
+        "{v}"
+    );
+    assert!(v[6].as_u64().unwrap() >= 60, "{v}");
+    assert!(
+        (v[7].as_f64().unwrap() - track.slices.iter().map(|s| s.depth).fold(0.0, f64::max)).abs()
+            < 1e-9,
+        "{v}"
+    );
 }
 
 /// A Dirichlet wall particle appears in frames at its fixed

@@ -127,7 +127,7 @@ fn point_melt_coarse_meets_f22s_observables_and_writes_them() {
         series.rows.len()
     );
     // The reader finds the same verdict in the stream.
-    let py = "import sys, json; sys.path.insert(0, 'tools'); import spatter_read as s; \
+    let py = "import sys, json; import spatter_read as s; \
               f, d, i = s.read_mcap(sys.argv[1]); c = i['check']; \
               print(json.dumps([c['kind'], c['pass'], len(c['series']['rows'])]))";
     let o = std::process::Command::new(common::python())

@@ -12,9 +12,9 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq mesa-vulkan-drivers >/dev/null
 fi
 
-# The Python reader (tools/spatter_read.py) is tested on files the simulator writes;
-# its packages live in .venv (tools/requirements.txt).
-if ! .venv/bin/python -c "import mcap, mcap_protobuf, numpy, matplotlib" >/dev/null 2>&1; then
+# The Python reader (the package in python/, `spatter-read`) is tested on files the
+# simulator writes, installed into .venv as a user installs it.
+if ! .venv/bin/python -c "import mcap, mcap_protobuf, numpy, pandas, matplotlib" >/dev/null 2>&1; then
     echo "setting up the Python reader's environment (.venv from tools/requirements.txt)"
     if ! python3 -m venv .venv >/dev/null 2>&1; then
         SUDO=""
@@ -25,6 +25,9 @@ if ! .venv/bin/python -c "import mcap, mcap_protobuf, numpy, matplotlib" >/dev/n
     fi
     .venv/bin/pip install -q --disable-pip-version-check -r tools/requirements.txt
 fi
+# The package itself, again on every run (a checkout's edits; a few seconds).
+.venv/bin/pip install -q --disable-pip-version-check --no-deps ./python
+rm -rf python/build python/*.egg-info
 
 # Any writable folder keeps the Vulkan loader quiet.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"

@@ -32,7 +32,7 @@ pub fn scene_at(path: &str) -> String {
     format!("{}/scenarios/{path}.toml", env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The Python with tools/requirements.txt installed: $SPATTER_PYTHON, else the
+/// The Python with the reader (python/, tools/requirements.txt) installed: $SPATTER_PYTHON, else the
 /// repository's .venv that tools/test.sh sets up.
 pub fn python() -> std::path::PathBuf {
     if let Ok(p) = std::env::var("SPATTER_PYTHON") {
@@ -41,20 +41,20 @@ pub fn python() -> std::path::PathBuf {
     let venv = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
     assert!(
         venv.exists(),
-        "no Python environment for tools/spatter_read.py: run tools/test.sh, or \
-         python3 -m venv .venv && .venv/bin/pip install -r tools/requirements.txt"
+        "no Python environment for the reader: run tools/test.sh, or python3 -m venv .venv \
+         && .venv/bin/pip install -r tools/requirements.txt && .venv/bin/pip install ./python"
     );
     venv
 }
 
-/// Run tools/spatter_read.py with `args`.
+/// Run the installed reader (`python -m spatter_read`, the `spatter-read`
+/// command) with `args`.
 pub fn reader(args: &[&str]) -> Output {
-    let script = format!("{}/tools/spatter_read.py", env!("CARGO_MANIFEST_DIR"));
     Command::new(python())
-        .arg(script)
+        .args(["-m", "spatter_read"])
         .args(args)
         .output()
-        .expect("run tools/spatter_read.py")
+        .expect("run python -m spatter_read")
 }
 
 /// A fresh, empty scratch folder for one test.

@@ -1,0 +1,5 @@
+import sys
+
+from spatter_read import cli
+
+sys.exit(cli())

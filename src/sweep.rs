@@ -287,6 +287,7 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
         "laser_radius": m.laser.as_ref().map(|l| l.radius),
         "laser_peak_power": m.laser.as_ref().map(|l| l.power.iter().map(|p| p.1).fold(0.0, f64::max)),
         "layer_thickness": m.powder.as_ref().map(|b| b.thickness),
+        "dx": m.dx,
         "track": track,
         "laser": r.laser,
         "check": r.check.as_ref().map(|c| serde_json::json!({
@@ -307,12 +308,17 @@ pub const KEYHOLE_DEPTH_OVER_WIDTH: f64 = 0.5;
 /// a particle over its width at the resolutions swept (0.1–0.2 at 5–10
 /// particles across); a track breaking into beads varies by its whole width.
 pub const UNSTABLE_WIDTH_SPREAD: f64 = 0.3;
+/// A 3D track's shape is not judged below this many particles deep (or four
+/// times as many across): a pool one particle deep has a depth/width set by
+/// the lattice, not by the physics.
+pub const RESOLVED_DEPTH_DX: f64 = 2.0;
 
 /// One row of the collected CSV.
 struct Row {
     vary: Vec<(String, String)>,
     exit: Option<i32>,
     dim: u32,
+    dx: f64,
     depth: f64,
     width: f64,
     length: f64,
@@ -326,13 +332,21 @@ struct Row {
 }
 
 /// The regime of a run that completed, by the criteria in order: lack of
-/// fusion (the steady track shallower than the layer), keyhole (3D: depth
+/// fusion (the steady track shallower than the layer), unresolved (3D: the
+/// track less than RESOLVED_DEPTH_DX particles deep or four times that
+/// across, too coarse to judge its shape), keyhole (3D: depth
 /// over width above KEYHOLE_DEPTH_OVER_WIDTH; 2D, where width is not defined:
 /// the surface under the beam sunk deeper than the beam radius), unstable
 /// (the width's spread above UNSTABLE_WIDTH_SPREAD), else conduction.
 fn regime(r: &Row, radius: f64) -> &'static str {
     if r.layer > 0.0 && r.mean_depth < r.layer {
         "lack_of_fusion"
+    } else if r.dim == 3
+        && r.dx > 0.0
+        && (r.mean_depth < RESOLVED_DEPTH_DX * r.dx
+            || r.mean_width < 2.0 * RESOLVED_DEPTH_DX * r.dx)
+    {
+        "unresolved"
     } else if (r.dim == 3 && r.mean_depth / r.mean_width > KEYHOLE_DEPTH_OVER_WIDTH)
         || (r.dim != 3 && radius > 0.0 && r.depression > radius)
     {
@@ -357,6 +371,7 @@ fn row(s: &CellSummary, layer: Option<f64>) -> Row {
         vary: s.vary.clone(),
         exit: s.exit_code,
         dim: num(&["dim"]) as u32,
+        dx: num(&["dx"]),
         depth: num(&["track", "pool", "max_depth"]),
         width: num(&["track", "pool", "max_width"]),
         length: num(&["track", "pool", "max_length"]),
@@ -668,6 +683,7 @@ fn process_map(path: &Path, keys: &[String], rows: &[Row]) -> Result<bool, Strin
             "keyhole" => RED,
             "lack_of_fusion" => CYAN,
             "unstable" => MAGENTA,
+            "unresolved" => RGBColor(160, 160, 160),
             _ => BLACK,
         };
         let mut seen: Vec<&str> = Vec::new();
@@ -752,6 +768,7 @@ mod tests {
             vary: Vec::new(),
             exit: Some(0),
             dim,
+            dx: 10e-6,
             depth,
             width,
             length: f64::NAN,
@@ -788,6 +805,10 @@ mod tests {
             regime(&r(2, 40e-6, 0.0, f64::NAN, 10e-6, f64::NAN), radius),
             "conduction"
         );
+        // one particle deep at 40 µm: not judged
+        let mut coarse = r(3, 40e-6, 60e-6, 0.1, 0.0, f64::NAN);
+        coarse.dx = 40e-6;
+        assert_eq!(regime(&coarse, radius), "unresolved");
         assert_eq!(plain(1500.0), "1500");
         assert_eq!(plain(2.5), "2.5");
         assert_eq!(plain(0.35), "0.35");

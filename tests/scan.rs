@@ -198,3 +198,27 @@ fn bad_scans_exit_2_naming_the_key() {
         "scan.tracks",
     );
 }
+
+/// The hatch scene (scenarios/pbf/hatch_bare_plate_3d.toml): three tracks
+/// 100 µm apart in y, a serpentine, the beam off in the 0.1 ms turnarounds,
+/// and the run long enough for the last track (no warning).
+#[test]
+fn the_hatch_scene_compiles_to_three_tracks() {
+    let l = load::load(
+        &common::scene_at("pbf/hatch_bare_plate_3d"),
+        &["dx=2e-5".into()],
+    )
+    .unwrap();
+    assert!(l.model.warnings.is_empty(), "{:?}", l.model.warnings);
+    let laser = l.model.laser.unwrap();
+    let y: Vec<f64> = laser.path.iter().map(|p| p.1[1]).collect();
+    let x: Vec<f64> = laser.path.iter().map(|p| p.1[0]).collect();
+    for (got, want) in y.iter().zip([1e-4, 1e-4, 2e-4, 2e-4, 3e-4, 3e-4]) {
+        assert!((got - want).abs() < 1e-12, "{y:?}");
+    }
+    for (got, want) in x.iter().zip([1.6e-4, 8e-4, 8e-4, 1.6e-4, 1.6e-4, 8e-4]) {
+        assert!((got - want).abs() < 1e-12, "{x:?}");
+    }
+    assert_eq!(laser.power.len(), 6);
+    assert!(laser.power_at(4.0e-4) == 0.0 && laser.power_at(5.0e-4) > 0.0);
+}

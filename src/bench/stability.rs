@@ -114,6 +114,7 @@ const LONG_RUNS: &[((&str, &str), &[&str])] = &[
         &["dx=0.025"],
     ),
     (scene_file!("pbf/line_melt_bare_plate"), &["dx=2e-5"]),
+    (scene_file!("pbf/hatch_bare_plate_3d"), &["dx=2e-5"]),
     (scene_file!("pbf/amb2018_02_a"), &["dx=2e-5"]),
     (scene_file!("pbf/amb2018_02_b"), &["dx=2e-5"]),
     (scene_file!("pbf/amb2018_02_c"), &["dx=2e-5"]),

@@ -274,6 +274,8 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
             "mean_width": t.mean(|s| s.width),
             "mean_height": t.mean(|s| s.height),
             "width_spread": t.width_spread(),
+            "steady_depth": t.steady_mean(|s| s.depth),
+            "steady_width": t.steady_mean(|s| s.width),
         })
     });
     serde_json::json!({
@@ -308,9 +310,9 @@ pub const KEYHOLE_DEPTH_OVER_WIDTH: f64 = 0.5;
 /// a particle over its width at the resolutions swept (0.1–0.2 at 5–10
 /// particles across); a track breaking into beads varies by its whole width.
 pub const UNSTABLE_WIDTH_SPREAD: f64 = 0.3;
-/// A 3D track's shape is not judged below this many particles deep (or four
-/// times as many across): a pool one particle deep has a depth/width set by
-/// the lattice, not by the physics.
+/// A 3D track's shape is not judged below this many particles deep (or twice
+/// as many across): a pool one particle deep has a depth/width set by the
+/// lattice, not by the physics.
 pub const RESOLVED_DEPTH_DX: f64 = 2.0;
 
 /// One row of the collected CSV.
@@ -333,8 +335,8 @@ struct Row {
 
 /// The regime of a run that completed, by the criteria in order: lack of
 /// fusion (the steady track shallower than the layer), unresolved (3D: the
-/// track less than RESOLVED_DEPTH_DX particles deep or four times that
-/// across, too coarse to judge its shape), keyhole (3D: depth
+/// track less than RESOLVED_DEPTH_DX particles deep or twice that across,
+/// too coarse to judge its shape), keyhole (3D: depth
 /// over width above KEYHOLE_DEPTH_OVER_WIDTH; 2D, where width is not defined:
 /// the surface under the beam sunk deeper than the beam radius), unstable
 /// (the width's spread above UNSTABLE_WIDTH_SPREAD), else conduction.
@@ -375,8 +377,23 @@ fn row(s: &CellSummary, layer: Option<f64>) -> Row {
         depth: num(&["track", "pool", "max_depth"]),
         width: num(&["track", "pool", "max_width"]),
         length: num(&["track", "pool", "max_length"]),
-        mean_depth: num(&["track", "mean_depth"]),
-        mean_width: num(&["track", "mean_width"]),
+        // the steady part's (runs collected before it existed: all slices')
+        mean_depth: {
+            let v = num(&["track", "steady_depth"]);
+            if v.is_finite() {
+                v
+            } else {
+                num(&["track", "mean_depth"])
+            }
+        },
+        mean_width: {
+            let v = num(&["track", "steady_width"]);
+            if v.is_finite() {
+                v
+            } else {
+                num(&["track", "mean_width"])
+            }
+        },
         width_spread: num(&["track", "width_spread"]),
         depression: num(&["track", "pool", "max_depression"]),
         peak_t: num(&["track", "pool", "max_temperature"]),
@@ -384,7 +401,9 @@ fn row(s: &CellSummary, layer: Option<f64>) -> Row {
         regime: String::new(),
     };
     let completed = f.and_then(|x| x.get("end")).and_then(|e| e.as_str()) == Some("completed");
+    let melted = num(&["track", "slices"]) > 0.0;
     r.regime = match s.exit_code {
+        Some(0) | Some(1) if completed && !melted => "no_melt".to_string(),
         Some(0) | Some(1) if completed && r.mean_depth.is_finite() => {
             regime(&r, num(&["laser_radius"])).to_string()
         }
@@ -411,8 +430,8 @@ pub fn collect(dir: &Path, layer: Option<f64>) -> Result<(PathBuf, Option<PathBu
     }
     let mut csv = m.keys.join(",");
     csv.push_str(
-        ",exit_code,max_depth_m,max_width_m,max_length_m,mean_remelt_depth_m,\
-         mean_width_m,depth_over_width,width_spread,max_depression_m,peak_temperature_K,\
+        ",exit_code,max_depth_m,max_width_m,max_length_m,steady_remelt_depth_m,\
+         steady_width_m,depth_over_width,width_spread,max_depression_m,peak_temperature_K,\
          layer_m,regime\n",
     );
     for r in &rows {
@@ -459,6 +478,9 @@ fn axis(key: &str, dim: u32) -> (f64, String) {
 
 /// A tick label without an exponent: 1500, 2.5, 0.35.
 fn plain(v: f64) -> String {
+    if v != 0.0 && v.abs() < 0.01 {
+        return format!("{v:.2e}");
+    }
     let s = if v.abs() >= 100.0 {
         format!("{v:.0}")
     } else {
@@ -538,6 +560,7 @@ fn process_map(path: &Path, keys: &[String], rows: &[Row]) -> Result<bool, Strin
     };
     let (xr, yr) = (range(&xs), range(&ys));
     // room on the right for the legend (bands and regimes)
+    let x_end = xr.end;
     let xr = xr.start..xr.end + 0.45 * (xs[xs.len() - 1] - xs[0]).max(xr.end - xr.start);
     let root = BitMapBackend::new(path, (1300, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
@@ -665,7 +688,7 @@ fn process_map(path: &Path, keys: &[String], rows: &[Row]) -> Result<bool, Strin
                             0.5 * (xs[i - 1] + xs[i])
                         };
                         let x1 = if i + 1 == xs.len() {
-                            xr.end
+                            x_end
                         } else {
                             0.5 * (xs[i] + xs[i + 1])
                         };
@@ -684,6 +707,7 @@ fn process_map(path: &Path, keys: &[String], rows: &[Row]) -> Result<bool, Strin
             "lack_of_fusion" => CYAN,
             "unstable" => MAGENTA,
             "unresolved" => RGBColor(160, 160, 160),
+            "no_melt" => RGBColor(255, 200, 0),
             _ => BLACK,
         };
         let mut seen: Vec<&str> = Vec::new();

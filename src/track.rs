@@ -360,9 +360,8 @@ impl TrackProfile {
     /// coefficient of variation std/mean of the widths; NaN in 2D (no width)
     /// or with fewer than three slices there.
     pub fn width_spread(&self) -> f64 {
-        let n = self.slices.len();
-        let steady = &self.slices[n / 10..n - n / 10];
-        let w: Vec<f64> = steady
+        let w: Vec<f64> = self
+            .steady()
             .iter()
             .map(|s| s.width)
             .filter(|w| w.is_finite() && *w > 0.0)
@@ -373,6 +372,27 @@ impl TrackProfile {
         let mean = w.iter().sum::<f64>() / w.len() as f64;
         let var = w.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / w.len() as f64;
         var.sqrt() / mean
+    }
+
+    /// The steady part of the track: the slices between a tenth and nine
+    /// tenths of the melted length (the start and the end are transients).
+    pub fn steady(&self) -> &[Slice] {
+        let n = self.slices.len();
+        &self.slices[n / 10..n - n / 10]
+    }
+
+    /// The mean of `f` over the steady slices (NaN without any).
+    pub fn steady_mean(&self, f: impl Fn(&Slice) -> f64) -> f64 {
+        let v: Vec<f64> = self
+            .steady()
+            .iter()
+            .map(f)
+            .filter(|v| v.is_finite())
+            .collect();
+        if v.is_empty() {
+            return f64::NAN;
+        }
+        v.iter().sum::<f64>() / v.len() as f64
     }
 
     pub fn mean(&self, f: impl Fn(&Slice) -> f64) -> f64 {

@@ -52,12 +52,32 @@ fn bad_overrides_exit_2() {
         ("shapes[].velocity=[0.0,0.0]", "shapes[].velocity"),
         ("shapes[0]x.velocity=[0.0,0.0]", "shapes[0]x.velocity"),
         ("shapes[0]=1", "shapes[0]"),
+        // a check's key of the wrong type; a whole [check] given inline
+        ("check.tolerance=\"tight\"", "check.tolerance"),
+        (
+            "check={ kind = \"hydrostatic\", tolerance = 0.02 }",
+            "check.surface",
+        ),
     ] {
         let out = spatter(&["validate", &scene, "--set", set]);
         let (_, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(2), "--set {set}: {stderr}");
         assert!(stderr.contains(key), "--set {set}: {stderr}");
     }
+}
+
+/// A key in a check's sub-table is named with its table.
+#[test]
+fn a_nested_check_key_is_named_whole() {
+    common::assert_input_error(
+        &[
+            "validate",
+            &common::scene_at("pbf/amb2018_02_c"),
+            "--set",
+            "check.measured.depth=\"deep\"",
+        ],
+        "check.measured.depth",
+    );
 }
 
 #[test]

@@ -12,7 +12,7 @@
 # array submitted with `sbatch --wait`, runs `sweep collect` on the array and
 # compares every cell's figures with the local sweep's (exit 1 on a
 # difference), then stops the daemons. tests/sweep.rs runs it when Slurm is
-# installed and the tests run as root. About 30 s.
+# installed and the tests run as root. About 12 s.
 #
 # On a real cluster: `spatter sweep SCENE --vary ... --slurm --out DIR` writes
 # DIR/sweep.slurm. Each array task runs `spatter sweep cell DIR i`, so DIR must

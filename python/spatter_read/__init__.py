@@ -515,7 +515,8 @@ def diagnostics(path):
 
 
 POOL_COLUMNS = ["time", "pool_length", "pool_width", "pool_depth", "depression_depth",
-                "pool_volume", "detached_melt_regions", "detached_melt_mass", "max_temperature"]
+                "pool_volume", "detached_melt_regions", "detached_melt_particles",
+                "detached_melt_mass", "max_temperature"]
 
 
 def pool_series(path):

@@ -31,6 +31,16 @@ pub(crate) fn cmd_sweep(a: SweepArgs) -> Result<ExitCode, SpatterError> {
         layer,
         slurm_args,
     } = a;
+    if let Some(l) = layer {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(InputError::new(
+                "sweep",
+                "--layer",
+                format!("a thickness > 0 in m, got {l}"),
+            )
+            .into());
+        }
+    }
     use spatter::sweep;
     use std::path::Path;
     let exe = std::env::current_exe().map_err(|e| SpatterError::Runtime(e.to_string()))?;

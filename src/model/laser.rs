@@ -431,11 +431,13 @@ fn scan_tables(
         if dim != 3 {
             return Err(cx.err("scan.tracks", "a 2D scene has one track"));
         }
-        let h = scan.hatch_spacing.unwrap_or(f64::NAN);
-        let turn = scan.turnaround.unwrap_or(f64::NAN);
+        let need = |key: &str, v: Option<f64>| match v {
+            Some(v) => cx.positive(key, v),
+            None => Err(cx.err(key, "missing: a scan of several tracks needs it")),
+        };
         (
-            cx.positive("scan.hatch_spacing", h)?,
-            cx.positive("scan.turnaround", turn)?,
+            need("scan.hatch_spacing", scan.hatch_spacing)?,
+            need("scan.turnaround", scan.turnaround)?,
         )
     } else {
         for (key, given) in [

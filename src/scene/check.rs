@@ -64,14 +64,24 @@ fn field_of(e: &toml::de::Error, text: &str) -> Option<String> {
         return named;
     }
     let from_span = e.span().and_then(|s| {
+        let upto = &text[..s.start.min(text.len())];
         let line = text[s.start.min(text.len())..].lines().next()?;
-        let head = text[..s.start.min(text.len())]
-            .rsplit('\n')
-            .next()
-            .unwrap_or("");
+        let head = upto.rsplit('\n').next().unwrap_or("");
         let key = format!("{head}{line}");
         let key = key.split('=').next()?.trim().trim_matches('"').to_string();
-        (!key.is_empty() && !key.contains([' ', '['])).then_some(key)
+        if key.is_empty() || key.contains([' ', '[']) {
+            return None;
+        }
+        // inside a sub-table ([measured]): its name before the key
+        let table = upto
+            .lines()
+            .map(str::trim)
+            .rfind(|l| l.starts_with('['))
+            .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
+        Some(match table {
+            Some(t) => format!("{t}.{key}"),
+            None => key,
+        })
     });
     from_span.or(named)
 }

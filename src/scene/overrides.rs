@@ -4,6 +4,20 @@
 
 use crate::error::InputError;
 
+/// The scene's sections that `--set 'name={ ... }'` gives whole, present or not
+/// (SceneFile's table fields).
+const SECTIONS: [&str; 9] = [
+    "run",
+    "check",
+    "watchdog",
+    "laser",
+    "scan",
+    "surface_tension",
+    "powder",
+    "contact",
+    "heat",
+];
+
 /// Sections searched, in order, for a bare `--set name=value`.
 const ALIAS_SECTIONS: [&str; 4] = ["simulation", "run", "domain", "check"];
 
@@ -19,7 +33,9 @@ pub(super) fn apply_override(
     let value = parse_value(raw.trim());
     let path: Vec<String> = if key.contains('.') {
         key.split('.').map(str::to_string).collect()
-    } else if table.get(key).is_some_and(toml::Value::is_table) && value.is_table() {
+    } else if value.is_table()
+        && (table.get(key).is_some_and(toml::Value::is_table) || SECTIONS.contains(&key))
+    {
         // A whole section: `--set 'check={ kind = "compression", tolerance = 0.02 }'`.
         vec![key.to_string()]
     } else {

@@ -26,7 +26,7 @@ if ! .venv/bin/python -c "import mcap, mcap_protobuf, numpy, pandas, matplotlib"
     .venv/bin/pip install -q --disable-pip-version-check -r tools/requirements.txt
 fi
 # The package itself, again on every run (a checkout's edits; a few seconds).
-.venv/bin/pip install -q --disable-pip-version-check --no-deps --no-build-isolation ./python
+.venv/bin/pip install -q --disable-pip-version-check --no-deps ./python
 rm -rf python/build python/*.egg-info
 
 # Any writable folder keeps the Vulkan loader quiet.

@@ -1,6 +1,6 @@
 // The parameter block and the Sim block: twins of src/params.rs and src/state.rs,
 // member for member (tests/params_layout.rs compares the two layouts through
-// naga). Bit-match rules (DESIGN.md): same operation order as the Rust twin, no
+// naga). Bit-match rules (docs/design.md): same operation order as the Rust twin, no
 // fma, no built-in transcendentals, explicit x*x+y*y+z*z.
 
 struct Sizes {

@@ -2,7 +2,7 @@
 // a_i = K sum_j m_j mu_ij/(rho_i rho_j) (u_ij . r_ij)/(r_ij^2 + eta^2) grad_i W_ij,
 // K = 2 (d + 2), mu_ij = 2 mu_i mu_j/(mu_i + mu_j) (the pair viscosity F22 (23)
 // uses: 0 against a free-slip wall). R18 prints mu_i mu_j/(mu_i + mu_j) and a
-// scalar (PAPERS-EXTRACT §5.4); with the harmonic mean it is mu/rho lap(u) for
+// scalar (R18 (3.18)); with the harmonic mean it is mu/rho lap(u) for
 // one fluid (the Poiseuille check measures it). The force on i is s d. On in
 // delta_wcsph scenes with viscosity_form = "marrone", where it replaces F22 (23)'s
 // viscous term. Twin of

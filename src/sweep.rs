@@ -276,6 +276,7 @@ pub fn run_figures(m: &crate::model::Model, r: &crate::run::RunReport) -> serde_
             "width_spread": t.width_spread(),
             "steady_depth": t.steady_mean(|s| s.depth),
             "steady_width": t.steady_mean(|s| s.width),
+            "tracks": t.tracks,
         })
     });
     serde_json::json!({

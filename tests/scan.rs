@@ -199,6 +199,25 @@ fn bad_scans_exit_2_naming_the_key() {
     );
 }
 
+/// A track that starts or ends off the plate is exit 2 naming the key that
+/// put it there; `laser.speed` (where a new user looks first) points to
+/// `scan.speed`.
+#[test]
+fn scans_off_the_domain_and_misplaced_keys_exit_2() {
+    let hatch = common::scene_at("pbf/hatch_bare_plate_3d");
+    for (set, key) in [
+        ("scan.hatch_spacing=2e-4", "scan.hatch_spacing"),
+        ("scan.length=1e-3", "scan.length"),
+        ("scan.start=[1.6e-4, -1e-5]", "scan.start"),
+        ("laser.speed=1.0", "laser.speed"),
+    ] {
+        common::assert_input_error(&["validate", &hatch, "--set", set], key);
+    }
+    let out = common::spatter(&["validate", &hatch, "--set", "laser.speed=1.0"]);
+    let (_, err) = common::text(&out);
+    assert!(err.contains("`scan.speed`"), "{err}");
+}
+
 /// The hatch scene (scenarios/pbf/hatch_bare_plate_3d.toml): three tracks
 /// 100 µm apart in y, a serpentine, the beam off in the 0.1 ms turnarounds,
 /// and the run long enough for the last track (no warning).
@@ -221,4 +240,49 @@ fn the_hatch_scene_compiles_to_three_tracks() {
     }
     assert_eq!(laser.power.len(), 6);
     assert!(laser.power_at(4.0e-4) == 0.0 && laser.power_at(5.0e-4) > 0.0);
+}
+
+/// The hatch scene's figures per track, on a short serpentine of two tracks
+/// 100 µm apart on a plate cut to 480 µm at Δx = 40 µm (a few seconds): each
+/// track's own melt is measured in its frame, centred nearer its own line than
+/// its neighbour's (within half the hatch spacing), and the second overlaps
+/// the first (the beam's 140 µm is wider than the hatch). The geometry of the
+/// figures is tested exactly in src/track.rs; this is the run's wiring, and
+/// the summary's `track.tracks`.
+#[test]
+fn a_hatch_run_reports_each_track_and_their_overlap() {
+    let scene = common::scene_at("pbf/hatch_bare_plate_3d");
+    let (_, r) = common::run_loaded(
+        &scene,
+        &[
+            "dx=4e-5",
+            "domain.max=[4.8e-4, 4.0e-4, 1.2e-4]",
+            "shapes[0].box={ min = [0.0, 0.0, 0.0], max = [4.8e-4, 4.0e-4, 8.0e-5] }",
+            "scan.start=[8e-5, 1.4e-4]",
+            "scan.length=3.2e-4",
+            "scan.tracks=2",
+            "run.end_time=5e-4",
+        ],
+        None,
+    );
+    let track = r.track.expect("a track");
+    let t = &track.tracks;
+    assert_eq!(t.len(), 2, "{t:?}");
+    for k in t {
+        assert!(k.melted_slices >= 4, "{k:?}");
+        assert!(k.width > 2.0 * 4e-5 && k.depth > 0.0, "{k:?}");
+        assert!(k.centre_offset.abs() < 0.5 * k.hatch_spacing, "{k:?}");
+    }
+    assert!(t[0].overlap_width.is_nan(), "{:?}", t[0]);
+    assert!(
+        t[1].overlap_width > 0.0 && t[1].overlap <= 1.0,
+        "{:?}",
+        t[1]
+    );
+    assert!((t[1].hatch_spacing - 1e-4).abs() < 1e-12);
+    let lines = track.summary(3);
+    assert!(
+        lines.iter().any(|l| l.starts_with("track 2 of 2")),
+        "{lines:?}"
+    );
 }

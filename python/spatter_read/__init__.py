@@ -13,6 +13,8 @@ As tables (NumPy arrays in pandas DataFrames):
     removed(path)          the particles that left: id, phase, time, side, x...
     solidification_records(path)  /solidification: every liquidus crossing
     track_slices(path)     /track: a row per slice along x
+    scan_tracks(path)      /track: a row per track of a hatch (width, depth,
+                           overlap with the track before, ...)
     bodies(path)           /bodies: a row per body per frame
     sweep_table(directory) a sweep's sweep.csv
 
@@ -295,7 +297,8 @@ def track(path, png):
     a.step(x, height, where="mid", label="resolidified surface")
     a.step(x, -depth, where="mid", label="remelt depth (negative down)")
     if any(v["width"] > 0 for v in s):
-        a.step(x, np.array([v["width"] for v in s]) * 1e6, where="mid", label="track width")
+        a.step(x, np.array([v["width"] for v in s]) * 1e6, where="mid",
+               label="track width (all tracks)" if tr.get("tracks") else "track width")
     a.set_xlabel("x (µm)")
     a.set_ylabel("µm")
     a.legend(fontsize=8)
@@ -311,7 +314,25 @@ def track(path, png):
         h, v = f["y"][near], f["z"][near]
         c = f["temperature"][near] if "temperature" in f else f["phase"][near]
         b.set_xlabel(f"y (µm), slice x = {mid * 1e6:.0f} µm")
-        b.axhline(s[len(s) // 2]["initial_surface"] * 1e6, color="red", lw=1)
+        top = s[len(s) // 2]["initial_surface"] * 1e6
+        b.axhline(top, color="red", lw=1)
+        # a hatch: each track's beam line and the extent of its own melt
+        # (steady means) above the surface, stacked so overlaps show
+        for k, ht in enumerate(tr.get("tracks", [])):
+            if abs(ht["direction"][0]) < 0.99 or ht["width"] is None:
+                continue  # tracks along x only: the section is a y-z plane
+            d = ht["direction"][0]
+            centre = (ht["line"][1] + d * (ht["centre_offset"] or 0.0)) * 1e6
+            half = 0.5 * ht["width"] * 1e6
+            level = top + (k + 1) * 1.5 * tr["dx"] * 1e6
+            colour = f"C{k % 10}"
+            b.axvline(ht["line"][1] * 1e6, color=colour, ls="--", lw=0.8)
+            b.plot([centre - half, centre + half], [level, level], color=colour, lw=3)
+            note = f"track {ht['track']}: {ht['width'] * 1e6:.0f} µm"
+            if ht.get("overlap") is not None:
+                note += f", overlap {ht['overlap']:.2f}"
+            b.annotate(note, (centre + half, level), fontsize=7, color=colour,
+                       xytext=(3, -3), textcoords="offset points")
     else:
         h, v = f["x"], f["y"]
         c = f["temperature"] if "temperature" in f else f["phase"]
@@ -549,6 +570,16 @@ def track_slices(path):
     df = _df(t.get("slices", []))
     df.attrs["pool"] = t.get("pool")
     return df
+
+
+def scan_tracks(path):
+    """The /track message's tracks of a hatch (a [scan] of several tracks):
+    a row per track (track, t_on, t_off, width, depth, centre_offset,
+    overlap_width, overlap, hatch_spacing, ...); None without a track."""
+    t = read_mcap(path)[2]["track"]
+    if t is None:
+        return None
+    return _df(t.get("tracks", []))
 
 
 def bodies(path):

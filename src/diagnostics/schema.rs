@@ -273,8 +273,29 @@ pub fn track_schema() -> serde_json::Value {
                     "max_depression": num("deepest the surface under the beam sank below the initial surface, m"),
                     "max_depression_time": num("s")
                 }
+            },
+            "tracks": {
+                "type": "array",
+                "description": "a [scan] of several tracks (3D): each track's own melt, means over its steady part (a tenth of its length in from either end); empty otherwise",
+                "items": {
+                    "type": "object",
+                    "properties": {
+                        "track": {"type": "integer", "description": "1, 2, ... in scan order"},
+                        "t_on": num("beam on, s"),
+                        "t_off": num("beam off, s"),
+                        "line": {"type": "array", "items": {"type": "number"}, "description": "where the beam starts the track (x, y), m"},
+                        "direction": {"type": "array", "items": {"type": "number"}, "description": "unit vector the beam moves along"},
+                        "melted_slices": {"type": "integer", "description": "slices of dx along the track its melt reached"},
+                        "width": num("extent across of its melt below the initial surface, + dx, m"),
+                        "depth": num("deepest its melt reached below the initial surface, m"),
+                        "centre_offset": num("centre of its melt across from the beam's line (+ left of its direction), m"),
+                        "overlap_width": num("width across where its melt and the previous track's meet at the same point of the plate, + dx (0 where they do not), m; null for the first"),
+                        "overlap": num("overlap_width / width"),
+                        "hatch_spacing": num("the scan's distance between centre lines, m")
+                    }
+                }
             }
         },
-        "required": ["dx", "slices", "pool"]
+        "required": ["dx", "slices", "pool", "tracks"]
     })
 }

@@ -80,6 +80,20 @@ pub struct Laser {
     pub power: Vec<(f64, f64)>,
     /// (time, lateral position) of the beam centre; unused lateral axes are 0.
     pub path: Vec<(f64, [f64; 2])>,
+    /// The tracks of a `[scan]` in scan order (empty for an explicit path).
+    pub tracks: Vec<ScanTrack>,
+}
+
+/// One track of a `[scan]`: the beam on at `t_on` at `start`, along `dir`
+/// for `length`, off at `t_off` (lateral coordinates, m; unused axes 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanTrack {
+    pub t_on: f64,
+    pub t_off: f64,
+    pub start: [f64; 2],
+    /// Unit vector along the track, the way the beam moves.
+    pub dir: [f64; 2],
+    pub length: f64,
 }
 
 impl Laser {
@@ -244,16 +258,19 @@ pub(super) fn laser_source(
     if let Some(t_off) = l.power_until {
         power = switch_off(power, t_off).map_err(|why| cx.err("laser.power_until", why))?;
     }
-    let path = match &scene.scan {
+    let (path, tracks) = match &scene.scan {
         Some(scan) => {
-            let (path, steps) = scan_tables(cx, scan, l, dim)?;
-            power = steps;
-            path
+            let s = scan_tables(cx, scan, l, &scene.domain, dim)?;
+            power = s.power;
+            (s.path, s.tracks)
         }
-        None => points("laser.path", &l.path, dim as usize)?
-            .iter()
-            .map(|e| (e[0], [e[1], if dim == 3 { e[2] } else { 0.0 }]))
-            .collect(),
+        None => (
+            points("laser.path", &l.path, dim as usize)?
+                .iter()
+                .map(|e| (e[0], [e[1], if dim == 3 { e[2] } else { 0.0 }]))
+                .collect(),
+            Vec::new(),
+        ),
     };
     Ok(Some(Laser {
         model: l.model,
@@ -263,6 +280,7 @@ pub(super) fn laser_source(
         absorption,
         power,
         path,
+        tracks,
     }))
 }
 
@@ -356,14 +374,14 @@ fn ray_tracing(
 /// from t_k (on, held for the dwell), then along the track at the scan speed
 /// to its end (off there); the turnaround moves it, off, to the next start.
 /// Tracks are `hatch_spacing` apart to the left of the first's direction;
-/// `alternating` reverses every other one. Returns (path, power steps).
-#[allow(clippy::type_complexity)]
+/// `alternating` reverses every other one.
 fn scan_tables(
     cx: &Ctx,
     scan: &crate::scene::ScanDef,
     l: &crate::scene::LaserDef,
+    domain: &crate::scene::Domain,
     dim: u32,
-) -> Result<(Vec<(f64, [f64; 2])>, Vec<(f64, f64)>), InputError> {
+) -> Result<ScanTables, InputError> {
     let p = match l.power {
         crate::scene::PowerDef::Constant(p) => p,
         crate::scene::PowerDef::Schedule(_) => {
@@ -452,7 +470,7 @@ fn scan_tables(
     };
     let left = [-dir[1], dir[0]];
     let pass = length / speed;
-    let (mut path, mut power) = (Vec::new(), Vec::new());
+    let (mut path, mut power, mut tracks) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..n {
         let back = scan.pattern == crate::scene::HatchPattern::Alternating && k % 2 == 1;
         let s = if back { length } else { 0.0 };
@@ -472,8 +490,52 @@ fn scan_tables(
         path.push((t + scan.dwell + pass, at(e)));
         power.push((t, p));
         power.push((t + scan.dwell + pass, 0.0));
+        // every track on the plate: its start and end inside the domain
+        for (end, x) in [("start", at(s)), ("end", at(e))] {
+            let outside = (0..lateral).find(|&a| {
+                domain.min.get(a).is_some_and(|lo| x[a] < *lo)
+                    || domain.max.get(a).is_some_and(|hi| x[a] > *hi)
+            });
+            if let Some(a) = outside {
+                let key = match (k, end) {
+                    (0, "start") => "scan.start",
+                    (0, _) => "scan.length",
+                    _ => "scan.hatch_spacing",
+                };
+                return Err(cx.err(
+                    key,
+                    format!(
+                        "track {} of {n} {end}s at {:?} m, outside the domain along {} ([{}, {}] m)",
+                        k + 1,
+                        &x[..lateral],
+                        ["x", "y"][a],
+                        domain.min[a],
+                        domain.max[a]
+                    ),
+                ));
+            }
+        }
+        let way = if back { -1.0 } else { 1.0 };
+        tracks.push(ScanTrack {
+            t_on: t,
+            t_off: t + scan.dwell + pass,
+            start: at(s),
+            dir: [way * dir[0], way * dir[1]],
+            length,
+        });
     }
-    Ok((path, power))
+    Ok(ScanTables {
+        path,
+        power,
+        tracks,
+    })
+}
+
+/// What a `[scan]` compiles to: the beam's path and power tables and its tracks.
+struct ScanTables {
+    path: Vec<(f64, [f64; 2])>,
+    power: Vec<(f64, f64)>,
+    tracks: Vec<ScanTrack>,
 }
 
 /// The schedule with the beam off from t_off on: steps at or after t_off are

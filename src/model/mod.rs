@@ -11,7 +11,9 @@ mod phases;
 mod tension;
 mod thermal;
 
-pub use laser::{fresnel_absorptivity, hagen_rubens_index, Laser, RayTracing, MAX_LASER_POINTS};
+pub use laser::{
+    fresnel_absorptivity, hagen_rubens_index, Laser, RayTracing, ScanTrack, MAX_LASER_POINTS,
+};
 pub use phases::{Evaporation, PhaseInfo, TemperatureWave, Thermal};
 pub use tension::SurfaceTension;
 

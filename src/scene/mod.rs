@@ -1049,6 +1049,16 @@ pub fn parse_str(
                 };
             }
         }
+        // the keys a scan's figures are looked for under, first
+        if matches!(
+            key.as_str(),
+            "laser.speed" | "laser.length" | "laser.hatch_spacing" | "laser.tracks"
+        ) {
+            msg.push_str(&format!(
+                "; a scan's figures are given in a [scan] section: `scan.{}` (docs/scenario-format.md, [scan])",
+                &key["laser.".len()..]
+            ));
+        }
         InputError::new(file, &key, msg)
     })?;
     Ok((scene, resolved))

@@ -1,7 +1,7 @@
 // uses: params grid phase
 // reads: pos phase
 // writes: keys cell_start cell_end cell_fluid sim
-// Neighbour search. Twin of src/backend/cpu/neighbors.rs.
+// Neighbour search. Twin of src/backend/cpu/neighbors/mod.rs.
 // 1. cell_keys: key (cell, index) per particle; a particle that has left the
 //    domain gets cell n_cells (after every cell), padding keys sort last.
 // 2. bitonic sort over the padded keys. Keys are unique, so the result is the single

@@ -1,7 +1,7 @@
 // uses: params
 // reads: cell_start cell_end sim
 // Thread indexing, the cell grid and the neighbour walk's helpers. Twin of
-// src/backend/cpu/neighbors.rs. The walk itself is written once, as the
+// src/backend/cpu/neighbors/grid.rs and walks.rs. The walk itself is written once, as the
 // #for_each_neighbor template (src/backend/gpu/shaders.rs expands it).
 
 // Linear thread index for 1D work split over a 2D dispatch grid (65535-group limit).

@@ -90,7 +90,7 @@ pub struct BenchRow {
     /// reorder scratch, sort keys, and the cell table spread over the particles
     /// (setup::memory_estimate).
     pub bytes_per_particle: f64,
-    /// The CPU backend's neighbour list on top (cpu/neighbors.rs `NeighborList`:
+    /// The CPU backend's neighbour list on top (cpu/neighbors/walks.rs `NeighborList`:
     /// 4 bytes per fluid pair, per fluid particle for itself, and per particle),
     /// None on the GPU, which keeps none.
     pub list_bytes_per_particle: Option<f64>,

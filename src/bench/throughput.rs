@@ -91,7 +91,8 @@ pub struct BenchRow {
     /// (setup::memory_estimate).
     pub bytes_per_particle: f64,
     /// The CPU backend's neighbour list on top (cpu/neighbors/walks.rs `NeighborList`:
-    /// 4 bytes per fluid pair, per fluid particle for itself, and per particle),
+    /// 4 bytes per entry, as primed: a fluid particle's or conducting solid's
+    /// neighbours and itself; and an offset per particle),
     /// None on the GPU, which keeps none.
     pub list_bytes_per_particle: Option<f64>,
     pub pass_ms: Vec<(String, f64)>,
@@ -183,7 +184,7 @@ fn measure(
     l: &Loaded,
     backend: &mut dyn Backend,
     steps: u32,
-    pairs: u64,
+    (pairs, listed): (u64, u64),
 ) -> Result<BenchRow, SpatterError> {
     backend.prime();
     backend.run_steps(2);
@@ -215,7 +216,7 @@ fn measure(
         list_bytes_per_particle: backend
             .describe()
             .starts_with("cpu")
-            .then(|| 4.0 * (pairs as f64 + fluid as f64 + n as f64) / n as f64),
+            .then(|| 4.0 * (listed as f64 + n as f64) / n as f64),
         pass_ms: Vec::new(),
     })
 }
@@ -382,6 +383,9 @@ pub fn throughput(opts: &Options) -> Result<(), SpatterError> {
                 CpuBackend::new(Params::new(&l.model, l.state.len() as u32), l.state.clone());
             cpu.prime();
             let pairs = cpu.pair_count();
+            // what one step lists (the density or continuity pass records it)
+            cpu.run_steps(1);
+            let listed = cpu.listed_count();
             drop(cpu);
             let makers: [(bool, &Make); 2] = [
                 (want_cpu, &cpu_backend),
@@ -408,7 +412,7 @@ pub fn throughput(opts: &Options) -> Result<(), SpatterError> {
                     report.skipped.push(line);
                     continue;
                 };
-                let mut row = measure(s, &l, b.as_mut(), steps, pairs)?;
+                let mut row = measure(s, &l, b.as_mut(), steps, (pairs, listed))?;
                 row.pass_ms = per_step(b.take_pass_times(), steps + 2);
                 drop(b);
                 if k == 1 {
@@ -448,6 +452,9 @@ pub fn throughput(opts: &Options) -> Result<(), SpatterError> {
         }
     }
     print_growth(&report.rows);
+    for line in heat_ratio_lines(&report.rows) {
+        println!("{line}");
+    }
     if let Some(path) = opts.json {
         super::write_json(path, &report)?;
     }
@@ -472,6 +479,30 @@ fn gpu_pass_times(l: &Loaded, steps: u32) -> Vec<(String, f64)> {
 /// and per fluid pair (a scaled scene keeps its walls a few layers thick, so
 /// small scenes are mostly wall, whose particles cost a fraction of a fluid
 /// one's), and each pass's share of the change.
+/// What a melt-pool step costs per particle against a plain fluid step: per
+/// backend, each line_melt row over the dam_break_3d row nearest its size
+/// (within a third of it).
+fn heat_ratio_lines(rows: &[BenchRow]) -> Vec<String> {
+    let mut out = Vec::new();
+    for heat in rows.iter().filter(|r| r.scene == "line_melt") {
+        let near = rows
+            .iter()
+            .filter(|r| r.scene == "dam_break_3d" && r.backend == heat.backend)
+            .filter(|r| (r.particles as f64 / heat.particles as f64 - 1.0).abs() < 1.0 / 3.0)
+            .min_by_key(|r| r.particles.abs_diff(heat.particles));
+        if let Some(fluid) = near {
+            out.push(format!(
+                "line_melt / dam_break_3d, {}: a melt-pool step costs {:.2}x a fluid step per particle ({} and {} particles)",
+                heat.backend,
+                fluid.particle_steps_per_s / heat.particle_steps_per_s,
+                heat.particles,
+                fluid.particles
+            ));
+        }
+    }
+    out
+}
+
 fn print_growth(rows: &[BenchRow]) {
     let mut keys: Vec<(&str, &str)> = Vec::new();
     for r in rows {

@@ -179,7 +179,8 @@ fn rate(pr: &Params, st: &State, i: usize, js: &[u32]) -> [f32; 2] {
 }
 
 /// `continuity_rate`: (dρ/dt, Γ) per particle; also records each fluid
-/// particle's neighbours in `list` for the forces pass (as the density pass does).
+/// particle's neighbours in `list` for the forces pass (as the density pass does,
+/// and each conducting solid's: `density::record_solid`).
 pub fn rates(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
     let n = st.active();
     let chunks = list.take_chunks(n.div_ceil(LIST_CHUNK));
@@ -193,7 +194,7 @@ pub fn rates(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborL
             for (k, out) in rates.iter_mut().enumerate() {
                 let i = c * LIST_CHUNK + k;
                 if pr.is_wall(s.phase[i]) {
-                    chunk.push(&[]);
+                    super::density::record_solid(pr, &s.pos, grid, i, s.phase[i], &mut chunk);
                     *out = [0.0, 1.0];
                     continue;
                 }

@@ -8,7 +8,8 @@ use crate::params::{Params, FLAG_PRESSURE_FLOOR};
 use crate::state::State;
 use rayon::prelude::*;
 
-/// Also records each fluid particle's neighbours in `list` for the forces pass.
+/// Also records each fluid particle's neighbours in `list` for the forces pass
+/// (and each conducting solid's, `record_solid`).
 pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborList) {
     let n = st.active();
     let (pos, mass, phase) = (&st.pos, &st.mass, &st.phase);
@@ -23,7 +24,7 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborLis
                 let i = c * LIST_CHUNK + k;
                 let ph = phase[i];
                 if pr.is_wall(ph) {
-                    chunk.push(&[]);
+                    record_solid(pr, pos, grid, i, ph, &mut chunk);
                     continue;
                 }
                 let sum = with_neighbors(pr, pos, grid, i, |js, r2| {
@@ -38,6 +39,26 @@ pub fn run(pr: &Params, st: &mut State, grid: &CellTable, list: &mut NeighborLis
         })
         .collect();
     list.store(grid, chunks);
+}
+
+/// The list entry of wall-kind particle i: a conducting solid's neighbours,
+/// which the interface pass (twice) and conduction sweep later in the step,
+/// so that they read the list instead of sweeping the cells three times (the
+/// same neighbours in the same order, so the same bits); none for a wall.
+#[inline(always)]
+pub fn record_solid(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    grid: &CellTable,
+    i: usize,
+    phase: u32,
+    chunk: &mut ListChunk,
+) {
+    if pr.conducts(phase) {
+        with_neighbors(pr, pos, grid, i, |js, _| chunk.push(js));
+    } else {
+        chunk.push(&[]);
+    }
 }
 
 #[inline(always)]

@@ -24,10 +24,12 @@
 //!   the solid ↔ liquid switch at f_l = ½.
 
 use super::neighbors::{
-    for_each_listed, for_each_neighbor, for_each_neighbor_among, Among, CellTable, NeighborList,
+    for_each_neighbor, for_each_neighbor_among, min_image, with_listed, Among, CellTable,
+    NeighborList,
 };
 use crate::backend::SolverSlot;
 use crate::kernel;
+use crate::lanes::Lane;
 use crate::params::{
     law_at, law_segment, Params, FLAG_BODIES, FLAG_CONDUCTIVITY_TABLE, FLAG_INTERFACE,
     FLAG_SOLIDIFICATION, HEAT_DIRICHLET, HEAT_LIQUID, HEAT_MELTS, HEAT_TRAPEZOIDAL, KIND_SOLID,
@@ -123,30 +125,11 @@ fn rate(
     laser_source: f32,
 ) -> f32 {
     let (pos, rho, phase, heat) = (&st.pos, &st.rho, &st.phase, &st.heat);
-    let eta2 = pr.kernel.eta2;
     let ph_i = phase[i];
     let k_i = near.k[i];
     let t_i = heat[i][H_TEMPERATURE];
-    let mut sum = 0.0f32;
-    for_each_listed(pr, pos, grid, list, i, |j, _, r2| {
-        if r2 <= 0.0 {
-            return;
-        }
-        let ph_j = phase[j];
-        let k_ij = if pr.conducts(ph_j) {
-            let k_j = near.k[j];
-            // Ordered operands: i and j compute the same bits, so the
-            // pair's fluxes cancel exactly in the total enthalpy.
-            4.0 * k_i.min(k_j) * k_i.max(k_j) / (k_i + k_j)
-        } else if pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0 {
-            2.0 * k_i
-        } else {
-            return;
-        };
-        let r = r2.sqrt();
-        let f = kernel::dw(pr, r) * r / (r2 + eta2);
-        let v_j = near.vol[j];
-        sum += v_j * k_ij * (t_i - heat[j][H_TEMPERATURE]) * f;
+    let sum = with_listed(pr, pos, grid, list, i, |js| {
+        conduction_sum(pr, st, near, i, k_i, t_i, js)
     });
     let mut source = laser_source;
     if pr.flag(crate::params::FLAG_VISCOUS_HEATING) {
@@ -158,6 +141,101 @@ fn rate(
         0.0
     };
     source - loss + sum / heat_density(pr, rho, ph_i, i)
+}
+
+/// Σ_j V_j k_ij (T_i − T_j) W'(r) r/(r² + η²) over the neighbours `js` of
+/// conducting particle i in their order, leaving out j = i (r = 0) and
+/// neighbours that neither conduct nor are Dirichlet walls. The terms of a
+/// block of eight are computed at once (eight lanes with AVX2,
+/// `conduction_terms`) and added one at a time in order; a neighbour left out
+/// adds +0, which leaves the sum's bits as they are (it starts at +0 and is
+/// never −0). The same bits as skipping it, and as the WGSL loop.
+#[inline(always)]
+fn conduction_sum(
+    pr: &Params,
+    st: &State,
+    near: &Conductors,
+    i: usize,
+    k_i: f32,
+    t_i: f32,
+    js: &[u32],
+) -> f32 {
+    let (pos, phase, heat) = (&st.pos, &st.phase, &st.heat);
+    let pi = pos[i];
+    let mut sum = 0.0f32;
+    for block in js.chunks(8) {
+        // per neighbour: r², V_j, T_j, the ordered conductivities and their
+        // sum, and which k_ij applies (0: both conduct, 1: Dirichlet wall,
+        // 2: none, or j = i)
+        let mut b = [[0.0f32; 8]; 7];
+        for (k, &j) in block.iter().enumerate() {
+            let j = j as usize;
+            let d = min_image(pr, pi, pos[j]);
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let ph_j = phase[j];
+            let (lo, hi, ksum, which) = if pr.conducts(ph_j) {
+                let k_j = near.k[j];
+                // Ordered operands: i and j compute the same bits, so the
+                // pair's fluxes cancel exactly in the total enthalpy.
+                (k_i.min(k_j), k_i.max(k_j), k_i + k_j, 0.0)
+            } else if pr.heat_flags(ph_j) & HEAT_DIRICHLET != 0 {
+                (0.0, 0.0, 1.0, 1.0)
+            } else {
+                (0.0, 0.0, 1.0, 2.0)
+            };
+            b[0][k] = r2;
+            b[1][k] = near.vol[j];
+            b[2][k] = heat[j][H_TEMPERATURE];
+            b[3][k] = lo;
+            b[4][k] = hi;
+            b[5][k] = ksum;
+            b[6][k] = if r2 <= 0.0 { 2.0 } else { which };
+        }
+        let terms = conduction_terms(pr, k_i, t_i, &b, block.len());
+        for &t in &terms[..block.len()] {
+            sum += t;
+        }
+    }
+    sum
+}
+
+/// `conduction_sum`'s terms of up to eight neighbours, the scalar operations
+/// lane by lane.
+#[inline(always)]
+fn conduction_terms(pr: &Params, k_i: f32, t_i: f32, b: &[[f32; 8]; 7], len: usize) -> [f32; 8] {
+    #[cfg(target_arch = "x86_64")]
+    if len == 8 && *crate::lanes::AVX2 {
+        // SAFETY: the CPU has AVX2 (checked once at run time).
+        return unsafe { conduction_terms_avx2(pr, k_i, t_i, b) };
+    }
+    let mut out = [0.0f32; 8];
+    for k in 0..len {
+        let lane = |a: usize| b[a][k];
+        out[k] = conduction_term(pr, k_i, t_i, [0, 1, 2, 3, 4, 5, 6].map(lane));
+    }
+    out
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn conduction_terms_avx2(pr: &Params, k_i: f32, t_i: f32, b: &[[f32; 8]; 7]) -> [f32; 8] {
+    use crate::lanes::F8;
+    conduction_term(pr, k_i, t_i, b.map(F8::from_array)).to_array()
+}
+
+/// V_j k_ij (T_i − T_j) W'(r) r/(r² + η²) with k_ij = 4 k_i k_j/(k_i + k_j)
+/// (ordered operands), 2 k_i against a Dirichlet wall, and 0 where neither
+/// applies or r = 0 (b: r², V_j, T_j, min k, max k, k_i + k_j, which).
+#[inline(always)]
+fn conduction_term<R: Lane>(pr: &Params, k_i: f32, t_i: f32, b: [R; 7]) -> R {
+    let c = R::splat;
+    let [r2, v_j, t_j, lo, hi, ksum, which] = b;
+    let both = c(4.0) * lo * hi / ksum;
+    let k_ij = which.where_lt(0.5, both, which.where_lt(1.5, c(2.0) * c(k_i), c(0.0)));
+    let r = r2.sqrt();
+    let f = kernel::dw(pr, r) * r / (r2 + c(pr.kernel.eta2));
+    let term = v_j * k_ij * (c(t_i) - t_j) * f;
+    which.where_lt(1.5, term, c(0.0))
 }
 
 /// `conduct`: explicit Euler, h_i += Δt dh_i/dt (J22 (21)); the laser pass left

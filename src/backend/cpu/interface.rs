@@ -21,10 +21,9 @@
 //! V = m/ρ (summation density for fluids, ρ0 for solids and walls), κ_F22 the
 //! same planar-lattice normalisation of the condensed side's δ.
 
-use super::neighbors::{
-    for_each_listed, for_each_neighbor, min_image, with_listed, CellTable, NeighborList,
-};
+use super::neighbors::{for_each_neighbor, min_image, with_listed, CellTable, NeighborList};
 use crate::kernel;
+use crate::lanes::Lane;
 use crate::params::{Params, FLAG_GAS_INTERFACE, KIND_GAS};
 use crate::state::State;
 use crate::state::{H_TEMPERATURE, S_DELTA, S_SHEPARD};
@@ -49,22 +48,8 @@ pub fn shepard(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
             if !condensed(pr, phase[i]) {
                 return 0.0;
             }
-            // Σ V_j W_ij over the condensed neighbours, eight kernels at a
-            // time, in the list's order (`kernel::sum_weighted_w`: a gas
-            // neighbour's weight is 0).
             with_listed(pr, pos, grid, list, i, |js| {
-                PAIRS.with(|p| {
-                    let (r2, wt) = &mut *p.borrow_mut();
-                    r2.clear();
-                    wt.clear();
-                    for &j in js {
-                        let j = j as usize;
-                        let d = min_image(pr, pos[i], pos[j]);
-                        r2.push(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                        wt.push(vol[j]);
-                    }
-                    kernel::sum_weighted_w(pr, r2, wt)
-                })
+                shepard_sum(pr, pos, &vol, i, js)
             })
         })
         .collect();
@@ -89,10 +74,50 @@ fn condensed_volumes(pr: &Params, st: &State) -> Vec<f32> {
         .collect()
 }
 
-thread_local! {
-    /// `shepard`'s r² and weights of one particle's neighbours.
-    static PAIRS: std::cell::RefCell<(Vec<f32>, Vec<f32>)> =
-        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+/// Σ_j V_j W_ij over the neighbours `js` in their order (a gas neighbour's
+/// V_j is 0: it adds +0). Eight kernels at a time with AVX2, added in order
+/// (`kernel::sum_weighted_w`'s operations, continued over the blocks), so the
+/// same bits as adding V_j W_ij one neighbour at a time.
+#[inline(always)]
+fn shepard_sum(pr: &Params, pos: &[[f32; 4]], vol: &[f32], i: usize, js: &[u32]) -> f32 {
+    let pi = pos[i];
+    let mut sum = 0.0f32;
+    for block in js.chunks(8) {
+        let (mut r2, mut wt) = ([0.0f32; 8], [0.0f32; 8]);
+        for (k, &j) in block.iter().enumerate() {
+            let j = j as usize;
+            let d = min_image(pr, pi, pos[j]);
+            r2[k] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            wt[k] = vol[j];
+        }
+        let terms = shepard_terms(pr, &r2, &wt, block.len());
+        for &t in &terms[..block.len()] {
+            sum += t;
+        }
+    }
+    sum
+}
+
+/// V_j W(√r²) of up to eight neighbours, the scalar operations lane by lane.
+#[inline(always)]
+fn shepard_terms(pr: &Params, r2: &[f32; 8], wt: &[f32; 8], len: usize) -> [f32; 8] {
+    #[cfg(target_arch = "x86_64")]
+    if len == 8 && *crate::lanes::AVX2 {
+        // SAFETY: the CPU has AVX2 (checked once at run time).
+        return unsafe { shepard_terms_avx2(pr, r2, wt) };
+    }
+    let mut out = [0.0f32; 8];
+    for k in 0..len {
+        out[k] = wt[k] * kernel::w(pr, r2[k].sqrt());
+    }
+    out
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn shepard_terms_avx2(pr: &Params, r2: &[f32; 8], wt: &[f32; 8]) -> [f32; 8] {
+    use crate::lanes::F8;
+    (F8::from_array(*wt) * kernel::w(pr, F8::from_array(*r2).sqrt())).to_array()
 }
 
 /// `normals`: F22's gas-interface form, or the free-surface form R18 (3.25)–(3.27)
@@ -104,11 +129,18 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
     let (n, active) = (st.len(), st.active());
     let (pos, phase, surface) = (&st.pos, &st.phase, &st.surface);
     // V_j and 1/Γ_j once per particle instead of once per pair (divisions;
-    // the same operations, so the same bits).
+    // the same operations, so the same bits); both 0 for a gas particle, which
+    // the sum leaves out (its term is then +0: `colour_gradient`).
     let vol = condensed_volumes(pr, st);
     let inv_gamma: Vec<f32> = (0..n)
         .into_par_iter()
-        .map(|j| 1.0 / surface[n + j][S_SHEPARD])
+        .map(|j| {
+            if condensed(pr, phase[j]) {
+                1.0 / surface[n + j][S_SHEPARD]
+            } else {
+                0.0
+            }
+        })
         .collect();
     let inv_h = pr.kernel.inv_h;
     let normals: Vec<[f32; 4]> = (0..active)
@@ -117,16 +149,8 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
             if !condensed(pr, phase[i]) || !pr.gets_interface(phase[i]) {
                 return [0.0; 4];
             }
-            let mut g = [0.0f32; 3];
-            for_each_listed(pr, pos, grid, list, i, |j, d, r2| {
-                if r2 <= 0.0 || !condensed(pr, phase[j]) {
-                    return;
-                }
-                let r = r2.sqrt();
-                let f = vol[j] * (inv_gamma[i] + inv_gamma[j]) * kernel::dw(pr, r) / r;
-                for a in 0..3 {
-                    g[a] += f * d[a];
-                }
+            let g = with_listed(pr, pos, grid, list, i, |js| {
+                colour_gradient(pr, pos, &vol, &inv_gamma, i, js)
             });
             let delta = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
             if delta > 0.1 * inv_h {
@@ -138,6 +162,96 @@ pub fn normals(pr: &Params, st: &mut State, grid: &CellTable, list: &NeighborLis
         })
         .collect();
     st.surface[..active].copy_from_slice(&normals);
+}
+
+/// g_i = Σ_j V_j (1/Γ_i + 1/Γ_j) ∇_iW_ij over the neighbours `js` in their
+/// order, leaving out j = i (r = 0) and gas (V_j = 1/Γ_j = 0). The factor
+/// V_j (1/Γ_i + 1/Γ_j) W'(r)/r of a block of eight neighbours is computed at
+/// once (eight lanes with AVX2, `colour_factors`), and the terms added one
+/// neighbour at a time in order; a neighbour left out adds +0, which leaves
+/// the sum's bits as they are (it is +0 or non-zero, never −0). The same bits
+/// as skipping it, and as the WGSL loop.
+#[inline(always)]
+fn colour_gradient(
+    pr: &Params,
+    pos: &[[f32; 4]],
+    vol: &[f32],
+    inv_gamma: &[f32],
+    i: usize,
+    js: &[u32],
+) -> [f32; 3] {
+    let mut g = [0.0f32; 3];
+    let pi = pos[i];
+    for block in js.chunks(8) {
+        let mut b = [[0.0f32; 8]; 6];
+        for (k, &j) in block.iter().enumerate() {
+            let j = j as usize;
+            let d = min_image(pr, pi, pos[j]);
+            b[0][k] = d[0];
+            b[1][k] = d[1];
+            b[2][k] = d[2];
+            b[3][k] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            b[4][k] = vol[j];
+            b[5][k] = inv_gamma[j];
+        }
+        let f = colour_factors(pr, inv_gamma[i], &b[3], &b[4], &b[5], block.len());
+        for k in 0..block.len() {
+            for a in 0..3 {
+                g[a] += f[k] * b[a][k];
+            }
+        }
+    }
+    g
+}
+
+/// V_j (1/Γ_i + 1/Γ_j) W'(r)/r for up to eight neighbours (r² > 0; 0 at
+/// r = 0), the scalar operations lane by lane.
+#[inline(always)]
+fn colour_factors(
+    pr: &Params,
+    inv_gamma_i: f32,
+    r2: &[f32; 8],
+    vol: &[f32; 8],
+    inv_gamma: &[f32; 8],
+    len: usize,
+) -> [f32; 8] {
+    #[cfg(target_arch = "x86_64")]
+    if len == 8 && *crate::lanes::AVX2 {
+        // SAFETY: the CPU has AVX2 (checked once at run time).
+        return unsafe { colour_factors_avx2(pr, inv_gamma_i, r2, vol, inv_gamma) };
+    }
+    let mut f = [0.0f32; 8];
+    for k in 0..len {
+        f[k] = colour_factor(pr, inv_gamma_i, r2[k], vol[k], inv_gamma[k]);
+    }
+    f
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn colour_factors_avx2(
+    pr: &Params,
+    inv_gamma_i: f32,
+    r2: &[f32; 8],
+    vol: &[f32; 8],
+    inv_gamma: &[f32; 8],
+) -> [f32; 8] {
+    use crate::lanes::F8;
+    colour_factor(
+        pr,
+        inv_gamma_i,
+        F8::from_array(*r2),
+        F8::from_array(*vol),
+        F8::from_array(*inv_gamma),
+    )
+    .to_array()
+}
+
+#[inline(always)]
+fn colour_factor<R: Lane>(pr: &Params, inv_gamma_i: f32, r2: R, vol: R, inv_gamma: R) -> R {
+    let r = r2.sqrt();
+    let f = vol * (R::splat(inv_gamma_i) + inv_gamma) * kernel::dw(pr, r) / r;
+    (-r2).where_lt(0.0, f, R::splat(0.0))
 }
 
 /// `wetting`: the prescribed normal near walls and solids, F22 (27)–(29), on the

@@ -84,6 +84,14 @@ impl CpuBackend {
             })
             .sum()
     }
+
+    /// Entries the neighbour list holds for the current cell table (a
+    /// neighbour index each, the particle itself included), 0 without one.
+    pub fn listed_count(&self) -> u64 {
+        self.list
+            .chunks(&self.grid)
+            .map_or(0, |c| c.iter().map(|chunk| chunk.items.len() as u64).sum())
+    }
 }
 
 /// The CPU twin of each dispatch, named as in the pass table (backend/passes.rs),

@@ -139,9 +139,11 @@ impl Entry for u32 {
     const UNKNOWN_BOUND: usize = 1 << 27;
 }
 
-/// The neighbours of every fluid particle, recorded by the density pass in the
-/// walk's order, so that the forces pass of the same step reads them instead of
-/// sweeping the cells again. Valid for one cell table (`CellTable::generation`).
+/// The neighbours of every fluid particle and every conducting solid, recorded
+/// by the density (or continuity) pass in the walk's order, so that the
+/// forces, interface and conduction passes of the same step read them instead
+/// of sweeping the cells again. Valid for one cell table
+/// (`CellTable::generation`).
 pub type NeighborList = Recorded<u32>;
 
 /// The neighbours of particles c·LIST_CHUNK .. (c+1)·LIST_CHUNK (none for a
@@ -150,13 +152,14 @@ pub type ListChunk = RecordChunk<u32>;
 
 /// Particle i's recorded neighbours; None without a list for this cell table,
 /// or for a particle the list holds none of (a wall: every fluid particle's
-/// entry holds at least itself).
+/// and conducting solid's entry holds at least itself).
 pub(super) fn listed<'a>(list: &'a NeighborList, grid: &CellTable, i: usize) -> Option<&'a [u32]> {
     list.entries(grid, i).filter(|js| !js.is_empty())
 }
 
 /// `for_each_neighbor`, read from the step's neighbour list when it holds the
-/// particle's neighbours for this cell table (a fluid particle's): the same j in the same order, with d and
+/// particle's neighbours for this cell table (a fluid particle's or a conducting
+/// solid's): the same j in the same order, with d and
 /// r² recomputed by `min_image` and the same sum, so the same bits. Without a list
 /// the particle's neighbours are swept into a per-thread scratch list first, so
 /// that `f` is called from one loop only: the compiler then inlines it and keeps
@@ -181,7 +184,7 @@ pub fn for_each_listed(
     })
 }
 
-/// `f` gets the neighbours j of fluid particle i, in `for_each_listed`'s order,
+/// `f` gets the neighbours j of particle i, in `for_each_listed`'s order,
 /// as one slice: the step's list, or the cells swept into a per-thread scratch
 /// list when the step has none.
 #[inline(always)]

@@ -116,49 +116,29 @@ unsafe fn sum_w_avx2(pr: &Params, r2: &[f32]) -> f32 {
     sum
 }
 
-/// Σ_k wt_k W(√r2_k) summed in the order given: the same bits as adding
-/// `wt_k * w(√r2_k)` one neighbour at a time (a Shepard sum Σ V_j W_ij, with
-/// wt = 0 for a neighbour the sum leaves out: it adds +0, which leaves a sum of
-/// non-negative terms as it is). Eight at a time with AVX2, as `sum_w`.
-pub fn sum_weighted_w(pr: &Params, r2: &[f32], wt: &[f32]) -> f32 {
-    assert_eq!(r2.len(), wt.len(), "one weight per distance");
+/// wt_k W(√r2_k) for the first `len` (≤ 8) entries: eight lanes with AVX2
+/// when the block is full, one at a time otherwise, the same operations either
+/// way. A Shepard sum Σ V_j W_ij adds them in order (wt = 0 for a neighbour it
+/// leaves out: +0, which leaves a sum of non-negative terms as it is).
+#[inline(always)]
+pub fn weighted_w8(pr: &Params, r2: &[f32; 8], wt: &[f32; 8], len: usize) -> [f32; 8] {
     #[cfg(target_arch = "x86_64")]
-    if *crate::lanes::AVX2 {
+    if len == 8 && *crate::lanes::AVX2 {
         // SAFETY: the CPU has AVX2 (checked once at run time).
-        return unsafe { sum_weighted_w_avx2(pr, r2, wt) };
+        return unsafe { weighted_w8_avx2(pr, r2, wt) };
     }
-    let mut sum = 0.0f32;
-    for (&x, &v) in r2.iter().zip(wt) {
-        sum += v * w(pr, x.sqrt());
+    let mut out = [0.0f32; 8];
+    for k in 0..len.min(8) {
+        out[k] = wt[k] * w(pr, r2[k].sqrt());
     }
-    sum
+    out
 }
 
-/// `sum_weighted_w` eight at a time (the tail one at a time).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn sum_weighted_w_avx2(pr: &Params, r2: &[f32], wt: &[f32]) -> f32 {
+unsafe fn weighted_w8_avx2(pr: &Params, r2: &[f32; 8], wt: &[f32; 8]) -> [f32; 8] {
     use crate::lanes::F8;
-    use std::arch::x86_64::{_mm256_loadu_ps, _mm256_sqrt_ps};
-    let mut sum = 0.0f32;
-    let (blocks, weights) = (r2.chunks_exact(8), wt.chunks_exact(8));
-    let (tail, tail_wt) = (blocks.remainder(), weights.remainder());
-    for (block, weight) in blocks.zip(weights) {
-        // SAFETY: each block holds eight f32; AVX is enabled here.
-        let (x, v) = unsafe {
-            (
-                _mm256_loadu_ps(block.as_ptr()),
-                F8(_mm256_loadu_ps(weight.as_ptr())),
-            )
-        };
-        for t in (v * w(pr, F8(_mm256_sqrt_ps(x)))).to_array() {
-            sum += t;
-        }
-    }
-    for (&x, &v) in tail.iter().zip(tail_wt) {
-        sum += v * w(pr, x.sqrt());
-    }
-    sum
+    (F8::from_array(*wt) * w(pr, F8::from_array(*r2).sqrt())).to_array()
 }
 
 /// dW/dr for the kernel chosen in `params.kernel.kind`, on one distance or on
@@ -321,11 +301,16 @@ mod tests {
                         s + v * w(&p, x.sqrt())
                     }
                 });
-                assert_eq!(
-                    sum_weighted_w(&p, &r2, &wt).to_bits(),
-                    skipping.to_bits(),
-                    "{kind:?}, {n}"
-                );
+                let mut blocks = 0.0f32;
+                for (x, v) in r2.chunks(8).zip(wt.chunks(8)) {
+                    let (mut xb, mut vb) = ([0.0f32; 8], [0.0f32; 8]);
+                    xb[..x.len()].copy_from_slice(x);
+                    vb[..v.len()].copy_from_slice(v);
+                    for t in &weighted_w8(&p, &xb, &vb, x.len())[..x.len()] {
+                        blocks += t;
+                    }
+                }
+                assert_eq!(blocks.to_bits(), skipping.to_bits(), "{kind:?}, {n}");
             }
             for block in r.chunks_exact(8) {
                 let block: [f32; 8] = block.try_into().unwrap();

@@ -75,9 +75,8 @@ fn condensed_volumes(pr: &Params, st: &State) -> Vec<f32> {
 }
 
 /// Σ_j V_j W_ij over the neighbours `js` in their order (a gas neighbour's
-/// V_j is 0: it adds +0). Eight kernels at a time with AVX2, added in order
-/// (`kernel::sum_weighted_w`'s operations, continued over the blocks), so the
-/// same bits as adding V_j W_ij one neighbour at a time.
+/// V_j is 0: it adds +0). Eight kernels at a time (`kernel::weighted_w8`),
+/// added in order, so the same bits as adding V_j W_ij one neighbour at a time.
 #[inline(always)]
 fn shepard_sum(pr: &Params, pos: &[[f32; 4]], vol: &[f32], i: usize, js: &[u32]) -> f32 {
     let pi = pos[i];
@@ -90,34 +89,12 @@ fn shepard_sum(pr: &Params, pos: &[[f32; 4]], vol: &[f32], i: usize, js: &[u32])
             r2[k] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             wt[k] = vol[j];
         }
-        let terms = shepard_terms(pr, &r2, &wt, block.len());
+        let terms = kernel::weighted_w8(pr, &r2, &wt, block.len());
         for &t in &terms[..block.len()] {
             sum += t;
         }
     }
     sum
-}
-
-/// V_j W(√r²) of up to eight neighbours, the scalar operations lane by lane.
-#[inline(always)]
-fn shepard_terms(pr: &Params, r2: &[f32; 8], wt: &[f32; 8], len: usize) -> [f32; 8] {
-    #[cfg(target_arch = "x86_64")]
-    if len == 8 && *crate::lanes::AVX2 {
-        // SAFETY: the CPU has AVX2 (checked once at run time).
-        return unsafe { shepard_terms_avx2(pr, r2, wt) };
-    }
-    let mut out = [0.0f32; 8];
-    for k in 0..len {
-        out[k] = wt[k] * kernel::w(pr, r2[k].sqrt());
-    }
-    out
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn shepard_terms_avx2(pr: &Params, r2: &[f32; 8], wt: &[f32; 8]) -> [f32; 8] {
-    use crate::lanes::F8;
-    (F8::from_array(*wt) * kernel::w(pr, F8::from_array(*r2).sqrt())).to_array()
 }
 
 /// `normals`: F22's gas-interface form, or the free-surface form R18 (3.25)–(3.27)
